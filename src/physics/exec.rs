@@ -1,0 +1,58 @@
+//! How the physics spreads work over threads. The physics never starts a
+//! thread: the engine hands it an `Exec`, and the physics cuts its work into
+//! fixed-size blocks whose results are combined in block order, so the answer
+//! is bit-identical whatever the executor and however many lanes it has.
+
+/// Runs work the physics hands it.
+pub trait Exec: Sync {
+    /// How many lanes `for_each_lane` runs at once.
+    fn lanes(&self) -> usize;
+    /// Run `f(lane)` for every lane in `0..lanes()`; return when all are done.
+    fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync));
+    /// Run two different jobs, at once where the executor can (functional
+    /// decomposition: the `split` mode); return when both are done.
+    fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync));
+    /// Whether the models should cut their work by function (sphere–sphere
+    /// beside sphere–wall, through `join`) rather than by data.
+    fn functional(&self) -> bool {
+        false
+    }
+}
+
+/// Everything on the calling thread.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Serial;
+
+impl Exec for Serial {
+    fn lanes(&self) -> usize {
+        1
+    }
+    fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
+        f(0)
+    }
+    fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {
+        a();
+        b();
+    }
+}
+
+/// The block range lane `lane` of `lanes` takes out of `blocks` blocks.
+pub fn lane_blocks(blocks: usize, lane: usize, lanes: usize) -> std::ops::Range<usize> {
+    let per = blocks.div_ceil(lanes.max(1));
+    let start = (lane * per).min(blocks);
+    start..(start + per).min(blocks)
+}
+
+/// Run `f(block)` for every block in `0..blocks`, blocks spread over lanes.
+pub fn for_each_block(exec: &dyn Exec, blocks: usize, f: &(dyn Fn(usize) + Sync)) {
+    let lanes = exec.lanes().min(blocks).max(1);
+    if lanes == 1 {
+        (0..blocks).for_each(f);
+        return;
+    }
+    exec.for_each_lane(&|lane| {
+        if lane < lanes {
+            lane_blocks(blocks, lane, lanes).for_each(f);
+        }
+    });
+}

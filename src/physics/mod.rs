@@ -1,0 +1,16 @@
+//! The physics: spheres in a cube, the collision models, the broad phase.
+//! It knows nothing of threads (it is handed an [`exec::Exec`]) or terminals.
+pub mod broad;
+pub mod contact;
+pub mod discrete;
+pub mod exec;
+pub mod flight;
+pub mod model;
+pub mod sphere;
+pub mod swept;
+pub mod world;
+
+pub use exec::{Exec, Serial};
+pub use model::{Model, ModelKind};
+pub use sphere::Sphere;
+pub use world::{Counters, World};

@@ -1,0 +1,31 @@
+use glam::DVec3;
+
+/// A frictionless hard sphere. 64 bytes: one cache line, so the hot loops touch
+/// one line per sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    pub pos: DVec3,
+    pub vel: DVec3,
+    pub radius: f64,
+    pub mass: f64,
+}
+
+impl Sphere {
+    /// A sphere of density 1 (mass = volume), as DESIGN.md defaults it.
+    pub fn new(pos: DVec3, vel: DVec3, radius: f64) -> Self {
+        Sphere {
+            pos,
+            vel,
+            radius,
+            mass: volume(radius),
+        }
+    }
+
+    pub fn kinetic_energy(&self) -> f64 {
+        0.5 * self.mass * self.vel.length_squared()
+    }
+}
+
+pub fn volume(radius: f64) -> f64 {
+    4.0 / 3.0 * std::f64::consts::PI * radius * radius * radius
+}

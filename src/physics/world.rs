@@ -1,0 +1,85 @@
+use super::sphere::Sphere;
+
+/// Running totals a model keeps while it steps; they feed the bench JSON and
+/// the screen.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Counters {
+    pub sphere_collisions: u64,
+    pub wall_collisions: u64,
+    /// Momentum given to the walls (sum of `2 m |v_n|`), for the pressure.
+    pub wall_momentum: f64,
+    /// Steps (or frames, for `exact`) that hit the event cap and were
+    /// finished without resolving every contact.
+    pub capped_steps: u64,
+}
+
+/// The cube `[0, size]^3` and the spheres in it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct World {
+    pub size: f64,
+    pub spheres: Vec<Sphere>,
+    /// Simulated time since the scene started.
+    pub time: f64,
+    pub counters: Counters,
+}
+
+impl World {
+    pub fn new(size: f64, spheres: Vec<Sphere>) -> Self {
+        World {
+            size,
+            spheres,
+            time: 0.0,
+            counters: Counters::default(),
+        }
+    }
+
+    pub fn kinetic_energy(&self) -> f64 {
+        // Fixed order: energy figures are part of what must be reproducible.
+        self.spheres.iter().map(Sphere::kinetic_energy).sum()
+    }
+
+    pub fn momentum(&self) -> glam::DVec3 {
+        self.spheres.iter().map(|s| s.mass * s.vel).sum()
+    }
+
+    /// `kT` from the mean kinetic energy per sphere (`2/3 <E_kin>`).
+    pub fn temperature(&self) -> f64 {
+        if self.spheres.is_empty() {
+            return 0.0;
+        }
+        2.0 / 3.0 * self.kinetic_energy() / self.spheres.len() as f64
+    }
+
+    /// Spheres whose centre lies outside `[r, L - r]` by more than `1e-9 L`.
+    pub fn escaped(&self) -> usize {
+        let tol = 1e-9 * self.size;
+        self.spheres
+            .iter()
+            .filter(|s| {
+                (0..3).any(|k| {
+                    s.pos[k] < s.radius - tol || s.pos[k] > self.size - s.radius + tol
+                })
+            })
+            .count()
+    }
+
+    /// Deepest pair overlap divided by the smaller radius (0 if none).
+    pub fn max_overlap_rel(&self) -> f64 {
+        let mut worst: f64 = 0.0;
+        super::broad::for_each_near_pair(&self.spheres, self.size, |i, j| {
+            let a = &self.spheres[i];
+            let b = &self.spheres[j];
+            let depth = a.radius + b.radius - a.pos.distance(b.pos);
+            if depth > 0.0 {
+                worst = worst.max(depth / a.radius.min(b.radius));
+            }
+        });
+        worst
+    }
+
+    pub fn has_non_finite(&self) -> bool {
+        self.spheres
+            .iter()
+            .any(|s| !(s.pos.is_finite() && s.vel.is_finite()))
+    }
+}
