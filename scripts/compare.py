@@ -118,6 +118,7 @@ def row(scene, engine, threading, threads, out, err, ref):
 def main():
     quick = "--quick" in sys.argv[1:]
     start = time.monotonic()
+    load_start = os.getloadavg()[0]
     build_s = build()
     rows, notes = [], []
     with tempfile.TemporaryDirectory(prefix="ballpit-compare-") as tmp:
@@ -152,6 +153,7 @@ def main():
                 engine = "rapier + CCD" if ccd else "rapier"
                 rows.append(row(name, engine, label, t, out, err, ref))
     total = time.monotonic() - start
+    load_end = os.getloadavg()[0]
 
     print(
         "| scene | engine / model | threading | threads | sphere-steps/s | × Rapier single "
@@ -165,7 +167,8 @@ def main():
         f"scene (on fast projectiles: Rapier single with CCD). Energy drift = |E_end − E_start| / "
         f"E_start; escaped = centres outside [r, L−r] by more than 1e-9 L (for Rapier, with the deepest as a fraction of the radius); deepest overlap = deepest "
         f"pair overlap / smaller radius at the end. Rapier 0.36.1 (f32, rayon `parallel` feature, "
-        f"length_unit = mean diameter); one run each on a {THREADS}-core machine."
+        f"length_unit = mean diameter); one run each on a {THREADS}-core machine, 1-minute load average {load_start:.1f} at the start "
+        f"and {load_end:.1f} at the end (other work competes for the cores: compare within a scene)."
     )
     for n in notes:
         print(f"- {n}")
