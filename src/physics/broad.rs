@@ -10,8 +10,9 @@ use parking_lot::Mutex;
 
 /// Below this many spheres, all pairs beat building a grid.
 const ALL_PAIRS_MAX: usize = 24;
-/// Cells per parallel block; fixed so results never depend on thread count.
-const CELL_BLOCK: usize = 256;
+/// Grid rows (cells along x at one y, z) per parallel block; fixed so results
+/// never depend on the thread count.
+const ROW_BLOCK: usize = 8;
 const BIG_BLOCK: usize = 16;
 
 #[derive(Clone, Copy, Debug, Default)]
@@ -19,6 +20,8 @@ struct Entry {
     pos: DVec3,
     reach: f64,
     id: u32,
+    /// Cell column along x: rows are swept in x order.
+    x: u32,
 }
 
 /// A pair that may touch: sphere indices, `i < j` not implied.
@@ -36,33 +39,46 @@ pub struct Grid {
     small_reach_max: f64,
     all_pairs: bool,
     scratch: Vec<f64>,
+    balls: Vec<(DVec3, f64)>,
+    fill: Vec<u32>,
     cell_slots: Vec<Mutex<Vec<Pair>>>,
     big_slots: Vec<Mutex<Vec<Pair>>>,
 }
 
 impl Grid {
-    /// Bin the spheres; sphere `i` reaches `reach(i)` from its centre during
-    /// the step, so a pair matters when their centres are within the sum.
-    pub fn build(&mut self, spheres: &[Sphere], size: f64, reach: impl Fn(&Sphere) -> f64) {
+    /// Bin the spheres. `ball(s)` is a centre and a reach: during the step
+    /// the sphere stays inside that ball, so a pair matters only when the
+    /// distance of the centres is at most the sum of the reaches.
+    pub fn build(&mut self, spheres: &[Sphere], size: f64, ball: impl Fn(&Sphere) -> (DVec3, f64)) {
         let n = spheres.len();
         self.entries.clear();
         self.big.clear();
+        self.balls.clear();
+        self.balls.extend(spheres.iter().map(ball));
         self.all_pairs = n <= ALL_PAIRS_MAX;
         if self.all_pairs {
-            self.big
-                .extend(spheres.iter().enumerate().map(|(i, s)| Entry {
-                    pos: s.pos,
-                    reach: reach(s),
-                    id: i as u32,
-                }));
+            self.big.extend(
+                self.balls
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &(pos, reach))| Entry {
+                        pos,
+                        reach,
+                        id: i as u32,
+                        x: 0,
+                    }),
+            );
             return;
         }
-        // Cell from the 98th percentile of reach: the bulk share few cells,
-        // the outliers go to the second level.
+        // Cell from the 98th percentile of reach (estimated on every 8th
+        // sphere: a function of the state only, so the grid, and the order
+        // pairs come out in, never depend on history): the bulk share few
+        // cells, the outliers go to the second level.
         self.scratch.clear();
-        self.scratch.extend(spheres.iter().map(&reach));
-        let max_reach = self.scratch.iter().copied().fold(0.0, f64::max);
-        let k = (n * 98 / 100).min(n - 1);
+        self.scratch
+            .extend(self.balls.iter().step_by(8).map(|b| b.1));
+        let max_reach = self.balls.iter().fold(0.0f64, |m, b| m.max(b.1));
+        let k = (self.scratch.len() * 98 / 100).min(self.scratch.len() - 1);
         let q = *self
             .scratch
             .select_nth_unstable_by(k, |a, b| a.total_cmp(b))
@@ -80,19 +96,19 @@ impl Grid {
         self.cell_start.clear();
         self.cell_start.resize(cells + 1, 0);
         self.keys.clear();
-        for (i, s) in spheres.iter().enumerate() {
-            let r = reach(s);
+        for (i, &(pos, r)) in self.balls.iter().enumerate() {
             if 2.0 * r <= self.cell {
-                let key = self.cell_of(s.pos);
+                let key = self.cell_of(pos);
                 self.small_reach_max = self.small_reach_max.max(r);
                 self.cell_start[key + 1] += 1;
                 self.keys.push(key as u32);
             } else {
                 self.keys.push(u32::MAX);
                 self.big.push(Entry {
-                    pos: s.pos,
+                    pos,
                     reach: r,
                     id: i as u32,
+                    x: 0,
                 });
             }
         }
@@ -102,15 +118,17 @@ impl Grid {
         let small = self.cell_start[cells] as usize;
         self.entries.resize(small, Entry::default());
         // Counting sort, stable: spheres of a cell keep index order.
-        let mut fill: Vec<u32> = self.cell_start[..cells].to_vec();
-        for (i, s) in spheres.iter().enumerate() {
-            let key = self.keys[i];
+        self.fill.clear();
+        self.fill.extend_from_slice(&self.cell_start[..cells]);
+        let nx = self.dims[0] as u32;
+        for (i, (&key, &(pos, reach))) in self.keys.iter().zip(&self.balls).enumerate() {
             if key != u32::MAX {
-                let slot = &mut fill[key as usize];
+                let slot = &mut self.fill[key as usize];
                 self.entries[*slot as usize] = Entry {
-                    pos: s.pos,
-                    reach: reach(s),
+                    pos,
+                    reach,
                     id: i as u32,
+                    x: key % nx,
                 };
                 *slot += 1;
             }
@@ -123,10 +141,6 @@ impl Grid {
         c(p.x, nx) + nx * (c(p.y, ny) + ny * c(p.z, nz))
     }
 
-    fn cell_count(&self) -> usize {
-        self.dims[0] * self.dims[1] * self.dims[2]
-    }
-
     /// Every pair within reach, in a fixed order (cell blocks, then the
     /// second level), found in parallel on `exec`; `keep` filters pairs.
     pub fn pairs<K: Fn(u32, u32) -> bool + Sync>(
@@ -136,10 +150,11 @@ impl Grid {
         out: &mut Vec<Pair>,
     ) {
         out.clear();
+        let rows = self.dims[1] * self.dims[2];
         let cell_blocks = if self.all_pairs {
             0
         } else {
-            self.cell_count().div_ceil(CELL_BLOCK)
+            rows.div_ceil(ROW_BLOCK)
         };
         let big_blocks = self.big.len().div_ceil(BIG_BLOCK);
         ensure_slots(&mut self.cell_slots, cell_blocks);
@@ -150,9 +165,9 @@ impl Grid {
             if b < cell_blocks {
                 let mut v = this.cell_slots[b].lock();
                 v.clear();
-                let end = ((b + 1) * CELL_BLOCK).min(this.cell_count());
-                for c in b * CELL_BLOCK..end {
-                    this.cell_pairs(c, &mut |i, j| {
+                let end = ((b + 1) * ROW_BLOCK).min(rows);
+                for r in b * ROW_BLOCK..end {
+                    this.row_pairs(r, &mut |i, j| {
                         if keep(i, j) {
                             v.push((i, j))
                         }
@@ -189,47 +204,60 @@ impl Grid {
         &self.entries[self.cell_start[base + x0] as usize..self.cell_start[base + x1 + 1] as usize]
     }
 
-    /// Pairs with at least one sphere in cell `c`, each found once: the cell
-    /// with itself and its 13 forward neighbours, read as 5 row ranges.
-    fn cell_pairs(&self, c: usize, f: &mut impl FnMut(u32, u32)) {
-        let (lo, hi) = (self.cell_start[c] as usize, self.cell_start[c + 1] as usize);
-        if lo == hi {
+    /// Entries of row `r` (= y + ny z), in x order.
+    #[inline]
+    fn row_entries(&self, r: usize) -> &[Entry] {
+        let nx = self.dims[0];
+        &self.entries[self.cell_start[r * nx] as usize..self.cell_start[(r + 1) * nx] as usize]
+    }
+
+    /// Pairs with at least one sphere in row `r`, each found once: each
+    /// sphere against the rest of its cell and the next cell along x, and
+    /// the cells x-1..=x+1 of the four forward rows (13 cells in all).
+    /// Each neighbour window is a pair of cursors that only move forward as
+    /// the sweep moves along x, so empty cells cost nothing.
+    fn row_pairs(&self, r: usize, f: &mut impl FnMut(u32, u32)) {
+        let here = self.row_entries(r);
+        if here.is_empty() {
             return;
         }
-        let [nx, ny, nz] = self.dims;
-        let (x, y, z) = (c % nx, (c / nx) % ny, c / (nx * ny));
-        let here = &self.entries[lo..hi];
-        // Same row: the rest of this cell and the next one along x.
-        let row_end = if x + 1 < nx {
-            self.cell_start[c + 2] as usize
-        } else {
-            hi
-        };
-        for (k, a) in here.iter().enumerate() {
-            for b in &self.entries[lo + k + 1..row_end] {
-                test(a, b, f);
-            }
-        }
-        let (x0, x1) = (x.saturating_sub(1), (x + 1).min(nx - 1));
-        let mut rows = [(0usize, 0usize); 4];
+        let [_, ny, nz] = self.dims;
+        let (y, z) = (r % ny, r / ny);
+        let mut others: [&[Entry]; 4] = [&[]; 4];
         let mut count = 0;
         if y + 1 < ny {
-            rows[count] = (y + 1, z);
+            others[count] = self.row_entries(r + 1);
             count += 1;
         }
         if z + 1 < nz {
             for yy in y.saturating_sub(1)..=(y + 1).min(ny - 1) {
-                rows[count] = (yy, z + 1);
+                others[count] = self.row_entries(yy + ny * (z + 1));
                 count += 1;
             }
         }
-        for &(yy, zz) in &rows[..count] {
-            let other = self.row(x0, x1, yy, zz);
-            if other.is_empty() {
-                continue;
+        let others = &others[..count];
+        let mut lo = [0usize; 4];
+        let mut hi = [0usize; 4];
+        let mut same_hi = 0;
+        for (k, a) in here.iter().enumerate() {
+            let x = a.x;
+            while same_hi < here.len() && here[same_hi].x <= x + 1 {
+                same_hi += 1;
             }
-            for a in here {
-                for b in other {
+            for b in &here[k + 1..same_hi] {
+                test(a, b, f);
+            }
+            for (o, row) in others.iter().enumerate() {
+                while lo[o] < row.len() && row[lo[o]].x + 1 < x {
+                    lo[o] += 1;
+                }
+                if hi[o] < lo[o] {
+                    hi[o] = lo[o];
+                }
+                while hi[o] < row.len() && row[hi[o]].x <= x + 1 {
+                    hi[o] += 1;
+                }
+                for b in &row[lo[o]..hi[o]] {
                     test(a, b, f);
                 }
             }
@@ -314,7 +342,7 @@ fn ensure_slots<T>(slots: &mut Vec<Mutex<Vec<T>>>, n: usize) {
 /// (centres within the sum of radii). Serial; for checks and placement.
 pub fn for_each_near_pair(spheres: &[Sphere], size: f64, mut f: impl FnMut(usize, usize)) {
     let mut grid = Grid::default();
-    grid.build(spheres, size, |s| s.radius);
+    grid.build(spheres, size, |s| (s.pos, s.radius));
     let mut out = Vec::new();
     grid.pairs(&super::exec::Serial, &|_: u32, _: u32| true, &mut out);
     for (i, j) in out {
