@@ -32,18 +32,23 @@ def dense_radius(n, packing):
     return (packing * 3.0 / (4.0 * math.pi * n)) ** (1.0 / 3.0)
 
 
-# name, scene flags for `ballpit bench`, steps, with Rapier's CCD as well.
+# name, scene flags for `ballpit bench` (its presets), steps, with Rapier's CCD as well.
 SCENES = [
-    ("dilute 1k", ["--count", "1000", "--radius", "0.01", "--speed", "0.5"], 1000, False),
-    ("dilute 10k", ["--count", "10000", "--radius", "0.01", "--speed", "0.5"], 150, False),
+    ("dilute 1k (gas, packing 0.034)", ["--scene", "gas"], 1000, False),
     (
-        "dense 4k, packing 0.25",
-        ["--count", "4000", "--radius", f"{dense_radius(4000, 0.25):.6f}", "--speed", "0.5"],
+        "dilute 10k (gas, r 0.01, packing 0.042)",
+        ["--scene", "gas", "--count", "10000", "--radius", "0.01"],
+        150,
+        False,
+    ),
+    (
+        "dense 4k (packing 0.25)",
+        ["--scene", "dense", "--count", "4000", "--radius", f"{dense_radius(4000, 0.25):.6f}"],
         300,
         False,
     ),
-    # 6 box lengths per second at dt 1/60: five diameters per step, so tunnelling is on the table.
-    ("fast projectiles 200", ["--count", "200", "--radius", "0.01", "--speed", "6"], 1500, True),
+    # 200 spheres of radius 0.005 at 20 box lengths per second: 33 diameters per step at dt 1/60.
+    ("fast projectiles 200", ["--scene", "projectiles"], 1500, True),
 ]
 COMMON = ["--seed", "7", "--box", "1", "--dt", repr(DT)]
 MODELS = ["discrete", "swept", "exact"]
@@ -61,7 +66,9 @@ def run(cmd, timeout=120):
         return None, f"timed out after {timeout} s"
     if p.returncode != 0:
         msg = (p.stderr.strip() or p.stdout.strip() or f"exit {p.returncode}").splitlines()[0]
-        return None, msg
+        if "invalid value" in msg and "--model" in msg:
+            msg = "model not in this build (`--model` refused it)"
+        return None, msg[:100]
     try:
         return json.loads(p.stdout.strip().splitlines()[-1]), ""
     except (ValueError, IndexError):
