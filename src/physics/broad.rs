@@ -239,28 +239,39 @@ impl Grid {
         let mut lo = [0usize; 4];
         let mut hi = [0usize; 4];
         let mut same_hi = 0;
-        for (k, a) in here.iter().enumerate() {
-            let x = a.x;
+        let mut k = 0;
+        // One cell at a time: its windows are found once for all its spheres.
+        while k < here.len() {
+            let x = here[k].x;
+            let mut end = k + 1;
+            while end < here.len() && here[end].x == x {
+                end += 1;
+            }
             while same_hi < here.len() && here[same_hi].x <= x + 1 {
                 same_hi += 1;
             }
-            for b in &here[k + 1..same_hi] {
-                test(a, b, f);
-            }
+            let mut windows: [&[Entry]; 4] = [&[]; 4];
             for (o, row) in others.iter().enumerate() {
                 while lo[o] < row.len() && row[lo[o]].x + 1 < x {
                     lo[o] += 1;
                 }
-                if hi[o] < lo[o] {
-                    hi[o] = lo[o];
-                }
+                hi[o] = hi[o].max(lo[o]);
                 while hi[o] < row.len() && row[hi[o]].x <= x + 1 {
                     hi[o] += 1;
                 }
-                for b in &row[lo[o]..hi[o]] {
+                windows[o] = &row[lo[o]..hi[o]];
+            }
+            for (j, a) in here[k..end].iter().enumerate() {
+                for b in &here[k + j + 1..same_hi] {
                     test(a, b, f);
                 }
+                for w in &windows[..others.len()] {
+                    for b in *w {
+                        test(a, b, f);
+                    }
+                }
             }
+            k = end;
         }
     }
 
