@@ -10,9 +10,9 @@ use parking_lot::Mutex;
 
 /// Below this many spheres, all pairs beat building a grid.
 const ALL_PAIRS_MAX: usize = 24;
-/// Grid rows (cells along x at one y, z) per parallel block; fixed so results
-/// never depend on the thread count.
-const ROW_BLOCK: usize = 8;
+/// Cell keys per parallel block; fixed so results never depend on the
+/// thread count.
+const KEY_BLOCK: usize = 2048;
 const BIG_BLOCK: usize = 16;
 
 #[derive(Clone, Copy, Debug, Default)]
@@ -20,16 +20,23 @@ struct Entry {
     pos: DVec3,
     reach: f64,
     id: u32,
-    /// Cell column along x: rows are swept in x order.
-    x: u32,
+    /// Padded cell key (see `Grid::side`).
+    key: u32,
 }
 
 /// A pair that may touch: sphere indices, `i < j` not implied.
 pub type Pair = (u32, u32);
 
+/// The grid is padded with one empty layer of cells on every side, so the
+/// neighbour cells of any real cell exist and need no bounds checks: the
+/// 13 forward neighbours of cell `c` are 5 contiguous key ranges at fixed
+/// offsets from `c`.
 #[derive(Default)]
 pub struct Grid {
-    dims: [usize; 3],
+    /// Real cells per side.
+    per_side: usize,
+    /// Padded cells per side (`per_side + 2`).
+    side: usize,
     inv_cell: f64,
     cell: f64,
     cell_start: Vec<u32>,
@@ -65,7 +72,7 @@ impl Grid {
                         pos,
                         reach,
                         id: i as u32,
-                        x: 0,
+                        key: 0,
                     }),
             );
             return;
@@ -86,13 +93,13 @@ impl Grid {
         let small_max = if max_reach <= 3.0 * q { max_reach } else { q };
         let want = (2.0 * small_max).max(f64::MIN_POSITIVE);
         // At most ~2 cells per sphere and 1024 per side keeps memory O(N).
-        let cap = ((2 * n) as f64).cbrt().ceil().clamp(1.0, 1024.0);
-        let per_side = (size / want).floor().clamp(1.0, cap) as usize;
-        self.dims = [per_side; 3];
-        self.cell = size / per_side as f64;
+        let cap = ((8 * n) as f64).cbrt().ceil().clamp(1.0, 1024.0);
+        self.per_side = (size / want).floor().clamp(1.0, cap) as usize;
+        self.side = self.per_side + 2;
+        self.cell = size / self.per_side as f64;
         self.inv_cell = 1.0 / self.cell;
         self.small_reach_max = 0.0;
-        let cells = per_side * per_side * per_side;
+        let cells = self.side * self.side * self.side;
         self.cell_start.clear();
         self.cell_start.resize(cells + 1, 0);
         self.keys.clear();
@@ -108,7 +115,7 @@ impl Grid {
                     pos,
                     reach: r,
                     id: i as u32,
-                    x: 0,
+                    key: 0,
                 });
             }
         }
@@ -120,7 +127,6 @@ impl Grid {
         // Counting sort, stable: spheres of a cell keep index order.
         self.fill.clear();
         self.fill.extend_from_slice(&self.cell_start[..cells]);
-        let nx = self.dims[0] as u32;
         for (i, (&key, &(pos, reach))) in self.keys.iter().zip(&self.balls).enumerate() {
             if key != u32::MAX {
                 let slot = &mut self.fill[key as usize];
@@ -128,20 +134,33 @@ impl Grid {
                     pos,
                     reach,
                     id: i as u32,
-                    x: key % nx,
+                    key,
                 };
                 *slot += 1;
             }
         }
     }
 
+    /// Padded key of the real cell holding `p` (clamped into the grid).
     fn cell_of(&self, p: DVec3) -> usize {
-        let [nx, ny, nz] = self.dims;
-        let c = |x: f64, n: usize| ((x * self.inv_cell) as isize).clamp(0, n as isize - 1) as usize;
-        c(p.x, nx) + nx * (c(p.y, ny) + ny * c(p.z, nz))
+        let c = self.cell_coords(p);
+        self.key(c[0] + 1, c[1] + 1, c[2] + 1)
     }
 
-    /// Every pair within reach, in a fixed order (cell blocks, then the
+    #[inline]
+    fn key(&self, x: usize, y: usize, z: usize) -> usize {
+        x + self.side * (y + self.side * z)
+    }
+
+    /// Real cell coordinates of `p`, clamped into `0..per_side`.
+    fn cell_coords(&self, p: DVec3) -> [usize; 3] {
+        let last = self.per_side - 1;
+        // Truncation is floor here (after max(0)), without a libm call.
+        let c = |x: f64| ((x * self.inv_cell).max(0.0) as usize).min(last);
+        [c(p.x), c(p.y), c(p.z)]
+    }
+
+    /// Every pair within reach, in a fixed order (key blocks, then the
     /// second level), found in parallel on `exec`; `keep` filters pairs.
     pub fn pairs<K: Fn(u32, u32) -> bool + Sync>(
         &mut self,
@@ -150,31 +169,29 @@ impl Grid {
         out: &mut Vec<Pair>,
     ) {
         out.clear();
-        let rows = self.dims[1] * self.dims[2];
-        let cell_blocks = if self.all_pairs {
+        let keys = self.cell_start.len().saturating_sub(1);
+        let key_blocks = if self.all_pairs {
             0
         } else {
-            rows.div_ceil(ROW_BLOCK)
+            keys.div_ceil(KEY_BLOCK)
         };
         let big_blocks = self.big.len().div_ceil(BIG_BLOCK);
-        ensure_slots(&mut self.cell_slots, cell_blocks);
+        ensure_slots(&mut self.cell_slots, key_blocks);
         ensure_slots(&mut self.big_slots, big_blocks);
         let this = &*self;
-        let total = cell_blocks + big_blocks;
-        for_each_block(exec, total, &|b| {
-            if b < cell_blocks {
+        for_each_block(exec, key_blocks + big_blocks, &|b| {
+            if b < key_blocks {
                 let mut v = this.cell_slots[b].lock();
                 v.clear();
-                let end = ((b + 1) * ROW_BLOCK).min(rows);
-                for r in b * ROW_BLOCK..end {
-                    this.row_pairs(r, &mut |i, j| {
-                        if keep(i, j) {
-                            v.push((i, j))
-                        }
-                    });
-                }
+                let lo = this.cell_start[b * KEY_BLOCK] as usize;
+                let hi = this.cell_start[((b + 1) * KEY_BLOCK).min(keys)] as usize;
+                this.entry_pairs(lo, hi, &mut |i, j| {
+                    if keep(i, j) {
+                        v.push((i, j))
+                    }
+                });
             } else {
-                let b = b - cell_blocks;
+                let b = b - key_blocks;
                 let mut v = this.big_slots[b].lock();
                 v.clear();
                 let end = ((b + 1) * BIG_BLOCK).min(this.big.len());
@@ -187,7 +204,7 @@ impl Grid {
                 }
             }
         });
-        for s in &self.cell_slots[..cell_blocks] {
+        for s in &self.cell_slots[..key_blocks] {
             out.extend_from_slice(&s.lock());
         }
         for s in &self.big_slots[..big_blocks] {
@@ -195,78 +212,40 @@ impl Grid {
         }
     }
 
-    /// Entries of the cells `x0..=x1` of row `(y, z)`: contiguous, since
-    /// keys run along x.
+    /// Entries of the cells with keys `k0..k1`: contiguous, keys being sorted.
     #[inline]
-    fn row(&self, x0: usize, x1: usize, y: usize, z: usize) -> &[Entry] {
-        let [nx, ny, _] = self.dims;
-        let base = nx * (y + ny * z);
-        &self.entries[self.cell_start[base + x0] as usize..self.cell_start[base + x1 + 1] as usize]
+    fn keys_range(&self, k0: usize, k1: usize) -> &[Entry] {
+        &self.entries[self.cell_start[k0] as usize..self.cell_start[k1] as usize]
     }
 
-    /// Entries of row `r` (= y + ny z), in x order.
-    #[inline]
-    fn row_entries(&self, r: usize) -> &[Entry] {
-        let nx = self.dims[0];
-        &self.entries[self.cell_start[r * nx] as usize..self.cell_start[(r + 1) * nx] as usize]
-    }
-
-    /// Pairs with at least one sphere in row `r`, each found once: each
-    /// sphere against the rest of its cell and the next cell along x, and
-    /// the cells x-1..=x+1 of the four forward rows (13 cells in all).
-    /// Each neighbour window is a pair of cursors that only move forward as
-    /// the sweep moves along x, so empty cells cost nothing.
-    fn row_pairs(&self, r: usize, f: &mut impl FnMut(u32, u32)) {
-        let here = self.row_entries(r);
-        if here.is_empty() {
-            return;
-        }
-        let [_, ny, nz] = self.dims;
-        let (y, z) = (r % ny, r / ny);
-        let mut others: [&[Entry]; 4] = [&[]; 4];
-        let mut count = 0;
-        if y + 1 < ny {
-            others[count] = self.row_entries(r + 1);
-            count += 1;
-        }
-        if z + 1 < nz {
-            for yy in y.saturating_sub(1)..=(y + 1).min(ny - 1) {
-                others[count] = self.row_entries(yy + ny * (z + 1));
-                count += 1;
-            }
-        }
-        let others = &others[..count];
-        let mut lo = [0usize; 4];
-        let mut hi = [0usize; 4];
-        let mut same_hi = 0;
-        let mut k = 0;
-        // One cell at a time: its windows are found once for all its spheres.
-        while k < here.len() {
-            let x = here[k].x;
-            let mut end = k + 1;
-            while end < here.len() && here[end].x == x {
-                end += 1;
-            }
-            while same_hi < here.len() && here[same_hi].x <= x + 1 {
-                same_hi += 1;
-            }
-            let mut windows: [&[Entry]; 4] = [&[]; 4];
-            for (o, row) in others.iter().enumerate() {
-                while lo[o] < row.len() && row[lo[o]].x + 1 < x {
-                    lo[o] += 1;
-                }
-                hi[o] = hi[o].max(lo[o]);
-                while hi[o] < row.len() && row[hi[o]].x <= x + 1 {
-                    hi[o] += 1;
-                }
-                windows[o] = &row[lo[o]..hi[o]];
-            }
-            for (j, a) in here[k..end].iter().enumerate() {
-                for b in &here[k + j + 1..same_hi] {
+    /// Pairs with at least one sphere among entries `lo..hi` (whole cells),
+    /// each found once: a sphere against the rest of its cell and the next
+    /// cell along x, and the cells x-1..=x+1 of the four forward rows.
+    fn entry_pairs(&self, lo: usize, hi: usize, f: &mut impl FnMut(u32, u32)) {
+        let s = self.side;
+        let cs = &self.cell_start[..];
+        let e = &self.entries[..];
+        let mut k = lo;
+        while k < hi {
+            let c = e[k].key as usize;
+            let end = cs[c + 1] as usize;
+            let row_end = cs[c + 2] as usize;
+            // Forward rows: (y+1, z), then (y-1..=y+1, z+1); x-1..=x+1 each.
+            let (r1, r2) = (c + s - 1, c + s * s - s - 1);
+            let (r3, r4) = (r2 + s, r2 + 2 * s);
+            let windows = [
+                &e[cs[r1] as usize..cs[r1 + 3] as usize],
+                &e[cs[r2] as usize..cs[r2 + 3] as usize],
+                &e[cs[r3] as usize..cs[r3 + 3] as usize],
+                &e[cs[r4] as usize..cs[r4 + 3] as usize],
+            ];
+            for i in k..end {
+                let a = &e[i];
+                for b in &e[i + 1..row_end] {
                     test(a, b, f);
                 }
-                for w in &windows[..others.len()] {
-                    for b in *w {
+                for w in windows {
+                    for b in w {
                         test(a, b, f);
                     }
                 }
@@ -280,18 +259,23 @@ impl Grid {
     /// that cover `p ± span`. The caller applies its own test.
     pub fn near(&self, p: DVec3, span: f64, f: &mut impl FnMut(u32, DVec3, f64)) {
         if !self.all_pairs && !self.entries.is_empty() {
-            let lo = self.cell_coords(p - DVec3::splat(span));
-            let hi = self.cell_coords(p + DVec3::splat(span));
-            for z in lo[2]..=hi[2] {
-                for y in lo[1]..=hi[1] {
-                    for b in self.row(lo[0], hi[0], y, z) {
-                        f(b.id, b.pos, b.reach);
-                    }
-                }
-            }
+            self.near_entries(p, span, &mut |b| f(b.id, b.pos, b.reach));
         }
         for b in &self.big {
             f(b.id, b.pos, b.reach);
+        }
+    }
+
+    fn near_entries(&self, p: DVec3, span: f64, f: &mut impl FnMut(&Entry)) {
+        let lo = self.cell_coords(p - DVec3::splat(span));
+        let hi = self.cell_coords(p + DVec3::splat(span));
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                let k = self.key(lo[0] + 1, y + 1, z + 1);
+                for b in self.keys_range(k, k + hi[0] - lo[0] + 1) {
+                    f(b);
+                }
+            }
         }
     }
 
@@ -300,38 +284,18 @@ impl Grid {
         self.small_reach_max
     }
 
-    fn grid_near(&self, a: &Entry, f: &mut impl FnMut(u32, u32)) {
-        let span = a.reach + self.small_reach_max;
-        let lo = self.cell_coords(a.pos - DVec3::splat(span));
-        let hi = self.cell_coords(a.pos + DVec3::splat(span));
-        for z in lo[2]..=hi[2] {
-            for y in lo[1]..=hi[1] {
-                for b in self.row(lo[0], hi[0], y, z) {
-                    test(a, b, f);
-                }
-            }
-        }
-    }
-
     /// Pairs of second-level sphere `k` with every grid sphere in its reach
     /// and with the second-level spheres after it.
     fn big_pairs(&self, k: usize, f: &mut impl FnMut(u32, u32)) {
         let a = &self.big[k];
         if !self.all_pairs && !self.entries.is_empty() {
-            self.grid_near(a, f);
+            self.near_entries(a.pos, a.reach + self.small_reach_max, &mut |b| {
+                test(a, b, f)
+            });
         }
         for b in &self.big[k + 1..] {
             test(a, b, f);
         }
-    }
-
-    fn cell_coords(&self, p: DVec3) -> [usize; 3] {
-        let c = |x: f64, n: usize| ((x * self.inv_cell).floor().max(0.0) as usize).min(n - 1);
-        [
-            c(p.x, self.dims[0]),
-            c(p.y, self.dims[1]),
-            c(p.z, self.dims[2]),
-        ]
     }
 }
 
