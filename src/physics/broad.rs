@@ -92,7 +92,8 @@ impl Grid {
             .1;
         let small_max = if max_reach <= 3.0 * q { max_reach } else { q };
         let want = (2.0 * small_max).max(f64::MIN_POSITIVE);
-        // At most ~2 cells per sphere and 1024 per side keeps memory O(N).
+        // At most ~8 cells per sphere (cheap: empty cells cost nothing to skip)
+        // and 1024 per side keep memory O(N).
         let cap = ((8 * n) as f64).cbrt().ceil().clamp(1.0, 1024.0);
         self.per_side = (size / want).floor().clamp(1.0, cap) as usize;
         self.side = self.per_side + 2;
