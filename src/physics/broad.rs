@@ -14,6 +14,8 @@ const ALL_PAIRS_MAX: usize = 24;
 /// thread count.
 const KEY_BLOCK: usize = 2048;
 const BIG_BLOCK: usize = 16;
+/// Spheres per parallel block while binning.
+const BUILD_BLOCK: usize = 4096;
 
 #[derive(Clone, Copy, Debug, Default)]
 struct Entry {
@@ -56,12 +58,29 @@ impl Grid {
     /// Bin the spheres. `ball(s)` is a centre and a reach: during the step
     /// the sphere stays inside that ball, so a pair matters only when the
     /// distance of the centres is at most the sum of the reaches.
-    pub fn build(&mut self, spheres: &[Sphere], size: f64, ball: impl Fn(&Sphere) -> (DVec3, f64)) {
+    /// The per-sphere arithmetic runs in parallel on `exec`; the counting
+    /// sort is serial integer work.
+    pub fn build(
+        &mut self,
+        spheres: &[Sphere],
+        size: f64,
+        ball: impl Fn(&Sphere) -> (DVec3, f64) + Sync,
+        exec: &dyn Exec,
+    ) {
         let n = spheres.len();
         self.entries.clear();
         self.big.clear();
-        self.balls.clear();
-        self.balls.extend(spheres.iter().map(ball));
+        self.balls.resize(n, (DVec3::ZERO, 0.0));
+        {
+            let chunks: Vec<Mutex<&mut [(DVec3, f64)]>> =
+                self.balls.chunks_mut(BUILD_BLOCK).map(Mutex::new).collect();
+            for_each_block(exec, chunks.len(), &|b| {
+                let mut chunk = chunks[b].lock();
+                for (slot, s) in chunk.iter_mut().zip(&spheres[b * BUILD_BLOCK..]) {
+                    *slot = ball(s);
+                }
+            });
+        }
         self.all_pairs = n <= ALL_PAIRS_MAX;
         if self.all_pairs {
             self.big.extend(
@@ -103,15 +122,30 @@ impl Grid {
         let cells = self.side * self.side * self.side;
         self.cell_start.clear();
         self.cell_start.resize(cells + 1, 0);
-        self.keys.clear();
-        for (i, &(pos, r)) in self.balls.iter().enumerate() {
-            if 2.0 * r <= self.cell {
-                let key = self.cell_of(pos);
+        self.keys.resize(n, 0);
+        {
+            let (last, side, inv_cell, cell) =
+                (self.per_side - 1, self.side, self.inv_cell, self.cell);
+            let balls = &self.balls;
+            let chunks: Vec<Mutex<&mut [u32]>> =
+                self.keys.chunks_mut(BUILD_BLOCK).map(Mutex::new).collect();
+            for_each_block(exec, chunks.len(), &|b| {
+                let mut chunk = chunks[b].lock();
+                for (slot, &(pos, r)) in chunk.iter_mut().zip(&balls[b * BUILD_BLOCK..]) {
+                    *slot = if 2.0 * r <= cell {
+                        let [x, y, z] = cell_coords(pos, inv_cell, last);
+                        ((x + 1) + side * ((y + 1) + side * (z + 1))) as u32
+                    } else {
+                        u32::MAX
+                    };
+                }
+            });
+        }
+        for (i, (&key, &(pos, r))) in self.keys.iter().zip(&self.balls).enumerate() {
+            if key != u32::MAX {
                 self.small_reach_max = self.small_reach_max.max(r);
-                self.cell_start[key + 1] += 1;
-                self.keys.push(key as u32);
+                self.cell_start[key as usize + 1] += 1;
             } else {
-                self.keys.push(u32::MAX);
                 self.big.push(Entry {
                     pos,
                     reach: r,
@@ -142,23 +176,13 @@ impl Grid {
         }
     }
 
-    /// Padded key of the real cell holding `p` (clamped into the grid).
-    fn cell_of(&self, p: DVec3) -> usize {
-        let c = self.cell_coords(p);
-        self.key(c[0] + 1, c[1] + 1, c[2] + 1)
-    }
-
     #[inline]
     fn key(&self, x: usize, y: usize, z: usize) -> usize {
         x + self.side * (y + self.side * z)
     }
 
-    /// Real cell coordinates of `p`, clamped into `0..per_side`.
     fn cell_coords(&self, p: DVec3) -> [usize; 3] {
-        let last = self.per_side - 1;
-        // Truncation is floor here (after max(0)), without a libm call.
-        let c = |x: f64| ((x * self.inv_cell).max(0.0) as usize).min(last);
-        [c(p.x), c(p.y), c(p.z)]
+        cell_coords(p, self.inv_cell, self.per_side - 1)
     }
 
     /// Every pair within reach, in a fixed order (key blocks, then the
@@ -300,6 +324,14 @@ impl Grid {
     }
 }
 
+/// Real cell coordinates of `p`, clamped into `0..=last`. Truncation is
+/// floor here (after max(0)), without a libm call.
+#[inline]
+fn cell_coords(p: DVec3, inv_cell: f64, last: usize) -> [usize; 3] {
+    let c = |x: f64| ((x * inv_cell).max(0.0) as usize).min(last);
+    [c(p.x), c(p.y), c(p.z)]
+}
+
 #[inline(always)]
 fn test(a: &Entry, b: &Entry, f: &mut impl FnMut(u32, u32)) {
     let s = a.reach + b.reach;
@@ -318,7 +350,7 @@ fn ensure_slots<T>(slots: &mut Vec<Mutex<Vec<T>>>, n: usize) {
 /// (centres within the sum of radii). Serial; for checks and placement.
 pub fn for_each_near_pair(spheres: &[Sphere], size: f64, mut f: impl FnMut(usize, usize)) {
     let mut grid = Grid::default();
-    grid.build(spheres, size, |s| (s.pos, s.radius));
+    grid.build(spheres, size, |s| (s.pos, s.radius), &super::exec::Serial);
     let mut out = Vec::new();
     grid.pairs(&super::exec::Serial, &|_: u32, _: u32| true, &mut out);
     for (i, j) in out {

@@ -82,13 +82,13 @@ impl Discrete {
                 &|| {
                     let mut g = detect.lock();
                     let (grid, pairs) = &mut *g;
-                    grid.build(sp, size, |s| (s.pos, s.radius));
+                    grid.build(sp, size, |s| (s.pos, s.radius), &serial);
                     grid.pairs(&serial, &overlapping, pairs);
                 },
                 &|| find_walls(&serial),
             );
         } else {
-            self.grid.build(sp, size, |s| (s.pos, s.radius));
+            self.grid.build(sp, size, |s| (s.pos, s.radius), exec);
             self.grid.pairs(exec, &overlapping, &mut self.pairs);
             find_walls(exec);
         }

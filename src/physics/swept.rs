@@ -103,7 +103,8 @@ impl Swept {
     fn step(&mut self, world: &mut World, dt: f64, exec: &dyn Exec) {
         let size = world.size;
         let n = world.spheres.len();
-        self.grid.build(&world.spheres, size, |s| path_ball(s, dt));
+        self.grid
+            .build(&world.spheres, size, |s| path_ball(s, dt), exec);
         let blocks = n.div_ceil(SPHERE_BLOCK);
         while self.wall_slots.len() < blocks {
             self.wall_slots.push(Mutex::new(Vec::new()));
