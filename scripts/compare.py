@@ -12,6 +12,7 @@ with the dependencies already compiled once (a cold build of rapier alone takes 
 import json
 import math
 import os
+import resource
 import shlex
 import subprocess
 import sys
@@ -60,17 +61,24 @@ commands = []
 def run(cmd, timeout=120):
     """Runs one command, returns (json or None, error text)."""
     commands.append(shlex.join(cmd))
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     try:
         p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
     except subprocess.TimeoutExpired:
         return None, f"timed out after {timeout} s"
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    # CPU seconds of the whole child (set-up included): unlike wall time, barely moved by other
+    # work on a shared machine, so single-thread rows stay comparable across the run.
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     if p.returncode != 0:
         msg = (p.stderr.strip() or p.stdout.strip() or f"exit {p.returncode}").splitlines()[0]
         if "invalid value" in msg and "--model" in msg:
             msg = "model not in this build (`--model` refused it)"
         return None, msg[:100]
     try:
-        return json.loads(p.stdout.strip().splitlines()[-1]), ""
+        out = json.loads(p.stdout.strip().splitlines()[-1])
+        out["process_cpu_seconds"] = cpu
+        return out, ""
     except (ValueError, IndexError):
         return None, "no JSON line in the output"
 
@@ -105,10 +113,17 @@ def fmt_sci(x):
     return "0" if x == 0 else f"{x:.1e}"
 
 
-def row(scene, engine, threading, threads, out, err, ref):
+def cpu_rate(out):
+    cpu = out and out.get("process_cpu_seconds")
+    return out["n"] * out["steps"] / cpu if cpu else None
+
+
+def row(scene, engine, threading, threads, out, err, ref, ref_cpu):
     if out is None:
-        return f"| {scene} | {engine} | {threading} | {threads} | failed: {err} | | | | |"
+        return f"| {scene} | {engine} | {threading} | {threads} | failed: {err} | | | | | | |"
     rate = out.get("sphere_steps_per_second")
+    crate = cpu_rate(out)
+    cratio = f"{crate / ref_cpu:.2f}x" if crate and ref_cpu else "n/a"
     escaped = out.get("escaped", "n/a")
     # The peer also says how deep: a count alone can't tell 1e-6 r inside a wall from tunnelling.
     depth = out.get("max_escape_rel")
@@ -117,6 +132,7 @@ def row(scene, engine, threading, threads, out, err, ref):
     ratio = f"{rate / ref:.2f}x" if rate and ref else "n/a"
     return (
         f"| {scene} | {engine} | {threading} | {threads} | {fmt_rate(rate)} | {ratio} | "
+        f"{fmt_rate(crate)} | {cratio} | "
         f"{fmt_sci(out.get('energy_drift_rel'))} | {escaped} | "
         f"{fmt_sci(out.get('max_overlap_rel'))} |"
     )
@@ -135,7 +151,7 @@ def main():
             csv = os.path.join(tmp, f"scene{i}.csv")
             how, err = make_scene(flags, csv)
             if how is None:
-                rows.append(f"| {name} | scene | | | failed: {err} | | | | |")
+                rows.append(f"| {name} | scene | | | failed: {err} | | | | | | |")
                 continue
             if how == "1":
                 notes.append(f"{name}: `--steps 0` was refused, the scene is the state after 1 step")
@@ -148,30 +164,33 @@ def main():
             # Like for like: on projectiles ballpit claims no tunnelling, so it meets Rapier's CCD.
             ref_out = rapier[(with_ccd, "single")][0]
             ref = ref_out and ref_out.get("sphere_steps_per_second")
+            ref_cpu = cpu_rate(ref_out)
             for model in MODELS:
                 for threading, t in THREADING:
                     out, err = run(
                         [BALLPIT, "bench", "--scene", csv, *COMMON, "--model", model,
                          "--threading", threading, "--threads", str(t), "--steps", k]
                     )
-                    rows.append(row(name, f"ballpit {model}", threading, t, out, err, ref))
+                    rows.append(
+                        row(name, f"ballpit {model}", threading, t, out, err, ref, ref_cpu)
+                    )
             for (ccd, label), (out, err) in rapier.items():
                 t = 1 if label == "single" else THREADS
                 engine = "rapier + CCD" if ccd else "rapier"
-                rows.append(row(name, engine, label, t, out, err, ref))
+                rows.append(row(name, engine, label, t, out, err, ref, ref_cpu))
     total = time.monotonic() - start
     load_end = os.getloadavg()[0]
 
     print(
         "| scene | engine / model | threading | threads | sphere-steps/s | × Rapier single "
-        "| energy drift | escaped | deepest overlap |"
+        "| per CPU-second | × Rapier single (CPU) | energy drift | escaped | deepest overlap |"
     )
-    print("|---|---|---|---:|---:|---:|---:|---:|---:|")
+    print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     print("\n".join(rows))
     print()
     print(
         f"dt = 1/60 s, box 1, seed 7. `× Rapier single` divides by Rapier single-thread on the same "
-        f"scene (on fast projectiles: Rapier single with CCD). Energy drift = |E_end − E_start| / "
+        f"scene (on fast projectiles: Rapier single with CCD), by wall time of the stepping; `per CPU-second` divides the sphere-steps by the CPU time of the whole process (user + system, set-up included), which other load on the machine barely moves. Energy drift = |E_end − E_start| / "
         f"E_start; escaped = centres outside [r, L−r] by more than 1e-9 L (for Rapier, with the deepest as a fraction of the radius); deepest overlap = deepest "
         f"pair overlap / smaller radius at the end. Rapier 0.36.1 (f32, rayon `parallel` feature, "
         f"length_unit = mean diameter); one run each on a {THREADS}-core machine, 1-minute load average {load_start:.1f} at the start "
