@@ -1,0 +1,293 @@
+//! Engine benchmarks: `pool` against `off` on a big `swept` scene (with the
+//! share of a step that can run in parallel at all), `split` against
+//! `pool`, and the frames per second pipelining buys `worker` when drawing
+//! costs about as much as the physics.
+//!
+//! `cargo bench --bench engine` (criterion; a phase breakdown is printed
+//! first).
+use ballpit::engine::{Engine, Settings, Snapshot, Threading};
+use ballpit::physics::broad::Grid;
+use ballpit::physics::{Exec, ModelKind, Serial, Sphere, World};
+use criterion::{Criterion, SamplingMode};
+use glam::DVec3;
+use parking_lot::Mutex;
+use rand::{Rng, SeedableRng};
+use rand_xoshiro::Xoshiro256PlusPlus;
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+const DT: f64 = 1.0 / 60.0;
+
+/// `n` spheres of radius `r` on a jittered lattice, random velocities.
+fn scene(n: usize, r: f64, speed: f64, seed: u64) -> World {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    let m = (n as f64).cbrt().ceil() as usize;
+    let cell = 1.0 / m as f64;
+    assert!(r < 0.5 * cell);
+    let room = 0.5 * cell - r;
+    let mut u = |a: f64| rng.random_range(-a..=a);
+    let spheres = (0..n)
+        .map(|i| {
+            let c = DVec3::new((i % m) as f64, ((i / m) % m) as f64, (i / (m * m)) as f64);
+            let p = (c + 0.5) * cell + DVec3::new(u(room), u(room), u(room));
+            let v = DVec3::new(u(1.0), u(1.0), u(1.0)) * speed;
+            Sphere::new(p, v, r)
+        })
+        .collect();
+    World::new(1.0, spheres)
+}
+
+fn settings(threading: Threading, threads: usize, tick: u32) -> Settings {
+    Settings {
+        model: ModelKind::Swept,
+        dt: DT,
+        tick,
+        threading,
+        threads,
+    }
+}
+
+/// CPU seconds the calling thread has run: unlike wall time, not inflated
+/// when other processes take the core.
+fn cpu_now() -> f64 {
+    let tid = ballpit::cpu::current_tid().expect("Linux thread id");
+    ballpit::cpu::thread_cpu_seconds_of(tid).expect("thread CPU time")
+}
+
+/// Runs every lane on the calling thread, one after another, and adds up
+/// the CPU time of those sections: what a pool would share out.
+struct SerialLanes {
+    spent: Mutex<f64>,
+}
+
+impl Exec for SerialLanes {
+    fn lanes(&self) -> usize {
+        2
+    }
+    fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
+        let t0 = cpu_now();
+        f(0);
+        f(1);
+        *self.spent.lock() += cpu_now() - t0;
+    }
+    fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {
+        let t0 = cpu_now();
+        a();
+        b();
+        *self.spent.lock() += cpu_now() - t0;
+    }
+}
+
+/// Candidate pairs of a `swept` step and the clusters they link spheres
+/// into: the contact events of one cluster never touch another's.
+fn clusters(w: &World) -> (usize, usize, usize, usize) {
+    let mut grid = Grid::default();
+    grid.build(&w.spheres, w.size, |s| s.radius + s.vel.length() * DT);
+    let mut pairs = Vec::new();
+    grid.pairs(&Serial, &|_, _| true, &mut pairs);
+    let mut parent: Vec<usize> = (0..w.spheres.len()).collect();
+    fn root(p: &mut [usize], mut i: usize) -> usize {
+        while p[i] != i {
+            p[i] = p[p[i]];
+            i = p[i];
+        }
+        i
+    }
+    let mut involved = vec![false; w.spheres.len()];
+    for &(i, j) in &pairs {
+        let (a, b) = (root(&mut parent, i as usize), root(&mut parent, j as usize));
+        parent[a.max(b)] = a.min(b);
+        involved[i as usize] = true;
+        involved[j as usize] = true;
+    }
+    let mut size = vec![0usize; w.spheres.len()];
+    for i in 0..w.spheres.len() {
+        if involved[i] {
+            let r = root(&mut parent, i);
+            size[r] += 1;
+        }
+    }
+    let count = size.iter().filter(|&&s| s > 0).count();
+    let largest = size.iter().copied().max().unwrap_or(0);
+    let inv = involved.iter().filter(|&&x| x).count();
+    (pairs.len(), inv, count, largest)
+}
+
+/// Where a `swept` step's CPU time goes: the sections the model hands its
+/// executor (what a pool can share) and the serial rest.
+fn phases(label: &str, world: &World) {
+    let steps = 10;
+    let mut w = world.clone();
+    let mut model = ModelKind::Swept.build();
+    model.advance(&mut w, DT, 2, &Serial);
+    let lanes = SerialLanes {
+        spent: Mutex::new(0.0),
+    };
+    let t0 = cpu_now();
+    model.advance(&mut w, DT, steps, &lanes);
+    let total = (cpu_now() - t0) / steps as f64;
+    let par = *lanes.spent.lock() / steps as f64;
+    let mut grid = Grid::default();
+    let t0 = cpu_now();
+    for _ in 0..steps {
+        grid.build(&w.spheres, w.size, |s| s.radius + s.vel.length() * DT);
+    }
+    let build = (cpu_now() - t0) / steps as f64;
+    let (pairs, involved, count, largest) = clusters(&w);
+    eprintln!(
+        "phases {label}: CPU per step {:.1} ms = shareable sections (grid pair search, \
+         flight) {:.1} ms + serial {:.1} ms (grid build {:.1} ms; pair bookkeeping + \
+         contact event loop {:.1} ms) => Amdahl bound for 2 threads {:.2}x; \
+         {pairs} candidate pairs, {involved} of {} spheres in {count} clusters, largest {largest}",
+        total * 1e3,
+        par * 1e3,
+        (total - par) * 1e3,
+        build * 1e3,
+        (total - par - build) * 1e3,
+        total / (total - par + par / 2.0),
+        w.spheres.len(),
+    );
+}
+
+/// Stand-in for the TUI's drawing: rotate, project and plot every sphere
+/// into a character canvas, `passes` times.
+struct Render {
+    canvas: Vec<u8>,
+    passes: usize,
+}
+
+impl Render {
+    const W: usize = 160;
+    const H: usize = 96;
+
+    fn draw(&mut self, snap: &Snapshot) -> u64 {
+        let (s, c) = (0.6f64.sin(), 0.6f64.cos());
+        let mut lit = 0u64;
+        for pass in 0..self.passes {
+            self.canvas.fill(b' ');
+            let tilt = pass as f64 * 1e-3;
+            for v in &snap.spheres {
+                let [x, y, z] = v.pos.map(|q| q - 0.5 * snap.size);
+                let (x, z) = (c * x + s * z, -s * x + c * z);
+                let (y, z) = (y * (1.0 - tilt) + z * tilt, z);
+                let k = 1.5 / (2.5 + z);
+                let px = ((x * k + 0.5) * Self::W as f64) as isize;
+                let py = ((y * k + 0.5) * Self::H as f64) as isize;
+                if (0..Self::W as isize).contains(&px) && (0..Self::H as isize).contains(&py) {
+                    let shade = (v.speed * 8.0).min(7.0) as u8;
+                    self.canvas[py as usize * Self::W + px as usize] = b'0' + shade;
+                }
+            }
+            lit += self.canvas.iter().filter(|&&b| b != b' ').count() as u64;
+        }
+        lit
+    }
+}
+
+fn frame(e: &mut Engine, render: &mut Render) {
+    e.start_frame().unwrap();
+    black_box(render.draw(e.snapshot()));
+    e.finish_frame().unwrap();
+}
+
+fn bench_pool(c: &mut Criterion, label: &str, world: &World) {
+    let mut g = c.benchmark_group(format!("swept_100k_{label}_5_steps"));
+    g.sampling_mode(SamplingMode::Flat)
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(10));
+    for (name, threading, k) in [
+        ("off", Threading::Off, 1),
+        ("pool1", Threading::Pool, 1),
+        ("pool2", Threading::Pool, 2),
+        ("split", Threading::Split, 2),
+    ] {
+        let mut e = Engine::new(world.clone(), settings(threading, k, 5)).unwrap();
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                e.start_frame().unwrap();
+                black_box(e.finish_frame().unwrap().energy);
+            })
+        });
+    }
+    g.finish();
+}
+
+/// Wall and per-thread CPU time of `frames` frames of physics plus drawing.
+fn pipeline_check(world: &World, threading: Threading, passes: usize, frames: usize) {
+    let mut e = Engine::new(world.clone(), settings(threading, 1, 1)).unwrap();
+    let mut render = Render {
+        canvas: vec![b' '; Render::W * Render::H],
+        passes,
+    };
+    frame(&mut e, &mut render);
+    let tid = e.physics_tid().unwrap();
+    let phys = || ballpit::cpu::thread_cpu_seconds_of(tid).unwrap();
+    let (m0, p0, t0) = (cpu_now(), phys(), Instant::now());
+    let mut physics_wall = 0.0;
+    for _ in 0..frames {
+        frame(&mut e, &mut render);
+        physics_wall += e.snapshot().physics_seconds;
+    }
+    let wall = t0.elapsed().as_secs_f64();
+    let f = frames as f64;
+    eprintln!(
+        "pipelining {threading}: {:.2} ms/frame wall; CPU per frame: main {:.2} ms, \
+         physics thread {:.2} ms; physics step wall {:.2} ms/frame",
+        wall / f * 1e3,
+        (cpu_now() - m0) / f * 1e3,
+        (phys() - p0) / f * 1e3,
+        physics_wall / f * 1e3,
+    );
+}
+
+fn bench_pipelining(c: &mut Criterion) {
+    let world = scene(20_000, 0.006, 0.5, 2);
+    // Calibrate: as many drawing passes as make drawing cost what the
+    // physics of a frame costs.
+    let mut e = Engine::new(world.clone(), settings(Threading::Off, 1, 1)).unwrap();
+    let t0 = Instant::now();
+    for _ in 0..20 {
+        e.start_frame().unwrap();
+        e.finish_frame().unwrap();
+    }
+    let physics = t0.elapsed().as_secs_f64() / 20.0;
+    let mut one = Render {
+        canvas: vec![b' '; Render::W * Render::H],
+        passes: 20,
+    };
+    let t0 = Instant::now();
+    black_box(one.draw(e.snapshot()));
+    let pass = t0.elapsed().as_secs_f64() / 20.0;
+    let passes = (physics / pass).round().max(1.0) as usize;
+    eprintln!(
+        "pipelining: physics {:.2} ms/frame, drawing {passes} passes x {:.3} ms",
+        physics * 1e3,
+        pass * 1e3
+    );
+    for threading in [Threading::Off, Threading::Worker] {
+        pipeline_check(&world, threading, passes, 100);
+    }
+    let mut g = c.benchmark_group("frame_physics_plus_draw_20k");
+    g.sample_size(30).measurement_time(Duration::from_secs(8));
+    for (name, threading) in [("off", Threading::Off), ("worker", Threading::Worker)] {
+        let mut e = Engine::new(world.clone(), settings(threading, 1, 1)).unwrap();
+        let mut render = Render {
+            canvas: vec![b' '; Render::W * Render::H],
+            passes,
+        };
+        g.bench_function(name, |b| b.iter(|| frame(&mut e, &mut render)));
+    }
+    g.finish();
+}
+
+fn main() {
+    let mut c = Criterion::default().configure_from_args();
+    let big = scene(100_000, 0.004, 0.5, 1);
+    phases("N=100000 r=0.004 v=0.5", &big);
+    phases("N=100000 r=0.004 v=0.1", &scene(100_000, 0.004, 0.1, 1));
+    phases("N=100000 r=0.002 v=0.1", &scene(100_000, 0.002, 0.1, 1));
+    bench_pool(&mut c, "v0.5", &big);
+    bench_pool(&mut c, "v0.1", &scene(100_000, 0.004, 0.1, 1));
+    bench_pipelining(&mut c);
+    c.final_summary();
+}
