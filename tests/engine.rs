@@ -146,6 +146,37 @@ fn every_mode_gives_the_same_bits() {
 }
 
 #[test]
+fn every_mode_gives_the_same_bits_on_the_presets() {
+    use ballpit::scene::{SceneSpec, build_world, presets::PRESETS};
+    for preset in PRESETS {
+        // Enough gas spheres that three pool lanes all get blocks.
+        let count = (preset.name == "gas").then_some(6000);
+        let spec = SceneSpec {
+            scene: Some(preset.name.into()),
+            count,
+            ..SceneSpec::default()
+        };
+        let world = build_world(&spec).unwrap();
+        for model in [ModelKind::Discrete, ModelKind::Swept] {
+            let name = preset.name;
+            let reference = run(&world, settings(model, Threading::Off, 1, 4), 5);
+            check_invariants(
+                &world,
+                &reference,
+                allowed_overlap(model, &world, 1.0 / 60.0),
+            );
+            for (threading, k) in modes() {
+                let got = run(&world, settings(model, threading, k, 4), 5);
+                assert!(
+                    bits(&got) == bits(&reference),
+                    "{model} {name}: {threading} K={k} differs from off"
+                );
+            }
+        }
+    }
+}
+
+#[test]
 fn a_thousand_mode_switches_change_nothing() {
     let world = scene(2500, 0.015, 0.3, 0, 0.8, 4);
     for model in [ModelKind::Discrete, ModelKind::Swept] {
