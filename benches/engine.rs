@@ -252,32 +252,35 @@ fn pipeline_check(world: &World, threading: Threading, passes: usize, frames: us
     );
 }
 
-fn bench_pipelining(c: &mut Criterion) {
-    let world = scene(20_000, 0.006, 0.5, 2);
-    // Calibrate: as many drawing passes as make drawing cost what the
-    // physics of a frame costs.
+/// Drawing passes that cost about what a frame's physics costs.
+fn calibrate(world: &World) -> usize {
     let mut e = Engine::new(world.clone(), settings(Threading::Off, 1, 1)).unwrap();
-    let t0 = Instant::now();
+    // CPU time, not wall: other processes on the machine must not skew it.
+    let t0 = cpu_now();
     for _ in 0..20 {
         e.start_frame().unwrap();
         e.finish_frame().unwrap();
     }
-    let physics = t0.elapsed().as_secs_f64() / 20.0;
+    let physics = (cpu_now() - t0) / 20.0;
     let mut one = Render {
         canvas: vec![b' '; Render::W * Render::H],
         passes: 20,
     };
-    let t0 = Instant::now();
+    let t0 = cpu_now();
     black_box(one.draw(e.snapshot()));
-    let pass = t0.elapsed().as_secs_f64() / 20.0;
+    let pass = (cpu_now() - t0) / 20.0;
     let passes = (physics / pass).round().max(1.0) as usize;
     eprintln!(
         "pipelining: physics {:.2} ms/frame, drawing {passes} passes x {:.3} ms",
         physics * 1e3,
         pass * 1e3
     );
+    passes
+}
+
+fn bench_pipelining(c: &mut Criterion, world: &World, passes: usize) {
     for threading in [Threading::Off, Threading::Worker] {
-        pipeline_check(&world, threading, passes, 100);
+        pipeline_check(world, threading, passes, 100);
     }
     let mut g = c.benchmark_group("frame_physics_plus_draw_20k");
     g.sample_size(30).measurement_time(Duration::from_secs(8));
@@ -292,14 +295,101 @@ fn bench_pipelining(c: &mut Criterion) {
     g.finish();
 }
 
+/// Engines run in turn, `batch` frames each, `rounds` times; the time
+/// ratios are taken round by round, so a machine whose load drifts (other
+/// processes) moves both sides of a ratio alike. Prints the median ratio of
+/// each pair `(slow, fast)` as the speed-up of `fast`, with min and max.
+fn paired(label: &str, engines: &mut [(&str, Engine)], batch: usize, rounds: usize, passes: usize) {
+    let mut render = Render {
+        canvas: vec![b' '; Render::W * Render::H],
+        passes,
+    };
+    let mut times = vec![Vec::new(); engines.len()];
+    for round in 0..rounds {
+        // Rotate who goes first, so no engine always runs after the same one.
+        for k in 0..engines.len() {
+            let i = (round + k) % engines.len();
+            let e = &mut engines[i].1;
+            let t0 = Instant::now();
+            for _ in 0..batch {
+                if passes == 0 {
+                    e.start_frame().unwrap();
+                    black_box(e.finish_frame().unwrap().energy);
+                } else {
+                    frame(e, &mut render);
+                }
+            }
+            times[i].push(t0.elapsed().as_secs_f64());
+        }
+    }
+    let names: Vec<&str> = engines.iter().map(|(n, _)| *n).collect();
+    for i in 0..names.len() {
+        for j in i + 1..names.len() {
+            let mut r: Vec<f64> = times[i].iter().zip(&times[j]).map(|(a, b)| a / b).collect();
+            r.sort_by(f64::total_cmp);
+            let mut ti = times[i].clone();
+            ti.sort_by(f64::total_cmp);
+            eprintln!(
+                "paired {label}: {} over {}: median {:.2}x (min {:.2}, max {:.2}; {rounds} rounds; \
+                 {} median {:.1} ms per {batch} frames)",
+                names[j],
+                names[i],
+                r[r.len() / 2],
+                r[0],
+                r[r.len() - 1],
+                names[i],
+                ti[ti.len() / 2] * 1e3,
+            );
+        }
+    }
+}
+
+fn engines(
+    world: &World,
+    modes: &[(&'static str, Threading, usize)],
+    tick: u32,
+) -> Vec<(&'static str, Engine)> {
+    modes
+        .iter()
+        .map(|&(name, t, k)| {
+            (
+                name,
+                Engine::new(world.clone(), settings(t, k, tick)).unwrap(),
+            )
+        })
+        .collect()
+}
+
 fn main() {
     let mut c = Criterion::default().configure_from_args();
-    let big = scene(100_000, 0.004, 0.5, 1);
-    phases("N=100000 r=0.004 v=0.5", &big);
-    phases("N=100000 r=0.004 v=0.1", &scene(100_000, 0.004, 0.1, 1));
+    let fast = scene(100_000, 0.004, 0.5, 1);
+    let slow = scene(100_000, 0.004, 0.1, 1);
+    phases("N=100000 r=0.004 v=0.5", &fast);
+    phases("N=100000 r=0.004 v=0.1", &slow);
     phases("N=100000 r=0.002 v=0.1", &scene(100_000, 0.002, 0.1, 1));
-    bench_pool(&mut c, "v0.5", &big);
-    bench_pool(&mut c, "v0.1", &scene(100_000, 0.004, 0.1, 1));
-    bench_pipelining(&mut c);
+    let modes = [
+        ("off", Threading::Off, 1),
+        ("pool2", Threading::Pool, 2),
+        ("split", Threading::Split, 2),
+    ];
+    for (label, world) in [
+        ("swept N=100000 v=0.1, 5 steps/frame", &slow),
+        ("swept N=100000 v=0.5, 5 steps/frame", &fast),
+    ] {
+        paired(label, &mut engines(world, &modes, 5), 1, 10, 0);
+    }
+    let small = scene(20_000, 0.006, 0.5, 2);
+    let passes = calibrate(&small);
+    let modes = [("off", Threading::Off, 1), ("worker", Threading::Worker, 1)];
+    paired(
+        "physics + drawing, swept N=20000",
+        &mut engines(&small, &modes, 1),
+        10,
+        15,
+        passes,
+    );
+    bench_pool(&mut c, "v0.5", &fast);
+    bench_pool(&mut c, "v0.1", &slow);
+    bench_pipelining(&mut c, &small, passes);
     c.final_summary();
 }
