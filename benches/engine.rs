@@ -48,11 +48,11 @@ fn settings(threading: Threading, threads: usize, tick: u32) -> Settings {
     }
 }
 
-/// CPU seconds the calling thread has run: unlike wall time, not inflated
-/// when other processes take the core.
+/// CPU seconds the calling thread has run (its CPU clock, exact to the
+/// nanosecond): unlike wall time, not inflated when other processes take
+/// the core.
 fn cpu_now() -> f64 {
-    let tid = ballpit::cpu::current_tid().expect("Linux thread id");
-    ballpit::cpu::thread_cpu_seconds_of(tid).expect("thread CPU time")
+    cpu_time::ThreadTime::now().as_duration().as_secs_f64()
 }
 
 /// Runs every lane on the calling thread, one after another, and adds up
@@ -264,11 +264,11 @@ fn calibrate(world: &World) -> usize {
     let physics = (cpu_now() - t0) / 20.0;
     let mut one = Render {
         canvas: vec![b' '; Render::W * Render::H],
-        passes: 20,
+        passes: 200,
     };
     let t0 = cpu_now();
     black_box(one.draw(e.snapshot()));
-    let pass = (cpu_now() - t0) / 20.0;
+    let pass = (cpu_now() - t0) / 200.0;
     let passes = (physics / pass).round().max(1.0) as usize;
     eprintln!(
         "pipelining: physics {:.2} ms/frame, drawing {passes} passes x {:.3} ms",
