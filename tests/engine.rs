@@ -227,7 +227,12 @@ fn worker_pipelines_snapshots() {
     e.start_frame().unwrap();
     e.start_frame().unwrap();
     assert_eq!(e.finish_frame().unwrap().frame, 3);
-    assert_eq!(e.world().time, 9.0 * (1.0 / 60.0));
+    assert_eq!(e.physics_threads(), ["physics"]);
+    e.command(Command::SetThreading(Threading::Pool));
+    e.start_frame().unwrap();
+    e.finish_frame().unwrap();
+    assert_eq!(e.physics_threads(), ["physics", "pool-0", "pool-1"]);
+    assert!((e.world().time - 12.0 / 60.0).abs() < 1e-12);
 }
 
 #[test]
@@ -416,6 +421,25 @@ fn radius_grows_until_spheres_touch() {
     // It stopped at contact, not before.
     let gap = min_gap_rel(w);
     assert!((0.0..1e-6).contains(&gap), "closest gap {gap}");
+    // Mixed radii keep their ratios; the largest becomes the target.
+    let world = scene(200, 0.02, 0.5, 0, 0.5, 11);
+    let before: Vec<f64> = world.spheres.iter().map(|s| s.radius).collect();
+    let largest = before.iter().copied().fold(0.0, f64::max);
+    // Half the room the closest pair (or wall) leaves: no limit is hit.
+    let f = 1.0 + 0.5 * min_gap_rel(&world);
+    let mut m = Engine::new(world, settings(ModelKind::Swept, Threading::Off, 1, 0)).unwrap();
+    m.command(Command::SetRadius(largest * f));
+    m.start_frame().unwrap();
+    assert_eq!(m.snapshot().notice, None);
+    for (s, r0) in m.world().spheres.iter().zip(&before) {
+        assert!((s.radius / r0 - f).abs() < 1e-12);
+    }
+    assert_eq!(m.world().max_overlap_rel(), 0.0);
+    // Off: the physics runs on the caller.
+    assert_eq!(
+        m.physics_threads(),
+        [std::thread::current().name().unwrap()]
+    );
     // Mass follows the volume at the same density.
     let s = &w.spheres[0];
     assert!((s.mass / ballpit::physics::sphere::volume(s.radius) - 1.0).abs() < 1e-12);

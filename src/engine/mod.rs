@@ -96,9 +96,12 @@ pub enum Command {
     SetThreads(usize),
     SetTick(u32),
     SetModel(ModelKind),
-    /// New spheres go into free space; removal drops the last ones.
+    /// New spheres (median radius, rms speed, random directions) go into
+    /// free space; removal drops the last ones.
     SetCount(usize),
-    /// Growth stops where spheres would touch; the snapshot's notice says so.
+    /// Scale every radius so the largest becomes this (mass follows, same
+    /// density). Growth stops where spheres would touch; the snapshot's
+    /// notice says so.
     SetRadius(f64),
     /// Back to the scene as it started.
     Reset,
@@ -249,20 +252,23 @@ impl Engine {
     }
 
     /// The threads the current settings put physics work on, driver first.
+    /// A model that runs one event loop (`exact`) ignores the executor, so
+    /// in `pool` and `split` it runs on `physics` alone.
     pub fn physics_threads(&self) -> Vec<String> {
-        match self.settings.threading {
+        let helpers: Vec<String> = match self.settings.threading {
             Threading::Off => {
-                vec![std::thread::current().name().unwrap_or("main").to_string()]
+                return vec![std::thread::current().name().unwrap_or("main").to_string()];
             }
-            Threading::Worker => vec!["physics".into()],
-            Threading::Pool => std::iter::once("physics".to_string())
-                .chain((0..self.settings.threads).map(|i| format!("pool-{i}")))
+            _ if self.settings.model.name() == "exact" => Vec::new(),
+            Threading::Worker => Vec::new(),
+            Threading::Pool => (0..self.settings.threads)
+                .map(|i| format!("pool-{i}"))
                 .collect(),
-            Threading::Split => std::iter::once("physics")
-                .chain(SPLIT_NAMES)
-                .map(String::from)
-                .collect(),
-        }
+            Threading::Split => SPLIT_NAMES.map(String::from).to_vec(),
+        };
+        std::iter::once("physics".to_string())
+            .chain(helpers)
+            .collect()
     }
 
     fn check(&self) -> anyhow::Result<()> {

@@ -188,17 +188,17 @@ impl FreeSpace {
     }
 }
 
-/// Scale every radius so the typical one becomes `target` (mass follows, at
-/// the same density). Growth stops short of the first contact a sphere would
+/// Scale every radius so the largest one becomes `target` (mass follows, at
+/// the same density; a uniform scene simply gets radius `target`). Growth stops short of the first contact a sphere would
 /// make with another or with a wall, and the returned notice says so.
 /// Spheres that already overlap (the `discrete` model allows it) are left to
 /// the model and do not hold the others back.
 pub fn set_radius(world: &mut World, target: f64) -> Option<String> {
-    let typical = typical_radius(world)?;
+    let largest = world.spheres.iter().map(|s| s.radius).reduce(f64::max)?;
     if !target.is_finite() || target <= 0.0 {
         return Some(format!("radius must be a positive number, not {target}"));
     }
-    let want = target / typical;
+    let want = target / largest;
     let mut factor = want;
     let mut notice = None;
     if want > 1.0 {
@@ -207,7 +207,7 @@ pub fn set_radius(world: &mut World, target: f64) -> Option<String> {
             factor = (limit * (1.0 - MARGIN)).max(1.0);
             notice = Some(format!(
                 "radius limit: {what} at r = {:.4}",
-                typical * factor
+                largest * factor
             ));
         }
     }
