@@ -105,7 +105,7 @@ impl OverlapScratch {
     /// Same value as `World::max_overlap_rel`: the max is order-free.
     fn max_overlap_rel(&mut self, world: &World, exec: &dyn Exec) -> f64 {
         let sp = &world.spheres;
-        self.grid.build(sp, world.size, |s| (s.pos, s.radius));
+        self.grid.build(sp, world.size, |s| (s.pos, s.radius), exec);
         let overlapping = |i: u32, j: u32| {
             let (a, b) = (&sp[i as usize], &sp[j as usize]);
             let s = a.radius + b.radius;

@@ -249,7 +249,7 @@ fn growth_limit(world: &World, want: f64) -> (f64, &'static str) {
     let mut reach = 1.0f64;
     loop {
         reach = (reach * 2.0).min(best.0);
-        grid.build(&world.spheres, size, |s| (s.pos, s.radius * reach));
+        grid.build(&world.spheres, size, |s| (s.pos, s.radius * reach), &Serial);
         grid.pairs(&Serial, &|_: u32, _: u32| true, &mut pairs);
         let mut touch = f64::INFINITY;
         for &(i, j) in &pairs {
