@@ -236,18 +236,36 @@ fn worker_pipelines_snapshots() {
 }
 
 #[test]
-fn idle_physics_thread_uses_no_cpu() {
-    let world = scene(400, 0.02, 0.0, 0, 0.5, 7);
-    let mut e = Engine::new(world, settings(ModelKind::Swept, Threading::Worker, 1, 4)).unwrap();
-    let tid = e.physics_tid().expect("physics thread id on Linux");
-    let cpu = || ballpit::cpu::thread_cpu_seconds_of(tid).unwrap();
-    for _ in 0..20 {
-        e.start_frame().unwrap();
-        e.finish_frame().unwrap();
+fn idle_physics_threads_use_no_cpu() {
+    let world = scene(3000, 0.01, 0.0, 0, 0.5, 7);
+    let mut e = Engine::new(world, settings(ModelKind::Swept, Threading::Worker, 2, 4)).unwrap();
+    // Run every threaded mode, so every engine thread exists and has worked.
+    for t in [Threading::Worker, Threading::Pool, Threading::Split] {
+        e.command(Command::SetThreading(t));
+        for _ in 0..10 {
+            e.start_frame().unwrap();
+            e.finish_frame().unwrap();
+        }
     }
+    let threads = e.thread_ids();
+    let names: Vec<&str> = threads.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(
+        names,
+        ["physics", "pool-0", "pool-1", "split-pair", "split-wall"]
+    );
+    let cpu = || -> Vec<f64> {
+        threads
+            .iter()
+            .map(|&(_, tid)| ballpit::cpu::thread_cpu_seconds_of(tid).unwrap())
+            .collect()
+    };
     let worked = cpu();
-    assert!(worked > 0.0, "the physics thread ran the worker frames");
+    assert!(
+        worked.iter().all(|&c| c > 0.0),
+        "every thread ran: {worked:?}"
+    );
     e.command(Command::SetThreading(Threading::Off));
+    e.start_frame().unwrap();
     let t0 = Instant::now();
     let before = cpu();
     let mut frames = 0;
@@ -256,13 +274,12 @@ fn idle_physics_thread_uses_no_cpu() {
         e.finish_frame().unwrap();
         frames += 1;
     }
-    let grew = cpu() - before;
-    let per_second = grew / t0.elapsed().as_secs_f64();
+    let wall = t0.elapsed().as_secs_f64();
     assert!(frames > 10, "the main thread ran frames meanwhile");
-    assert!(
-        per_second < 1e-3,
-        "physics thread used {per_second} s/s while off"
-    );
+    for (((name, _), b), a) in threads.iter().zip(before).zip(cpu()) {
+        let per_second = (a - b) / wall;
+        assert!(per_second < 1e-3, "{name} used {per_second} s/s while off");
+    }
 }
 
 /// Panics on the frame it is told to, on the lane it is told to.

@@ -251,6 +251,20 @@ impl Engine {
         self.worker.tid()
     }
 
+    /// `(name, kernel thread id)` of every thread the engine has started so
+    /// far (Linux): `physics`, then the pool and split threads that exist.
+    pub fn thread_ids(&self) -> Vec<(String, i32)> {
+        let pool = self.pool.iter().flat_map(|p| p.thread_ids());
+        let split = self.split.iter().flat_map(|s| s.thread_ids());
+        self.worker
+            .tid()
+            .map(|t| ("physics".to_string(), t))
+            .into_iter()
+            .chain(pool)
+            .chain(split)
+            .collect()
+    }
+
     /// The threads the current settings put physics work on, driver first.
     /// A model that runs one event loop (`exact`) ignores the executor, so
     /// in `pool` and `split` it runs on `physics` alone.

@@ -22,6 +22,21 @@ impl PoolExec {
     pub fn threads(&self) -> usize {
         self.threads
     }
+
+    /// `(name, kernel thread id)` of every pool thread (Linux).
+    pub fn thread_ids(&self) -> Vec<(String, i32)> {
+        thread_ids(&self.pool)
+    }
+}
+
+fn thread_ids(pool: &rayon::ThreadPool) -> Vec<(String, i32)> {
+    pool.broadcast(|_| {
+        let name = std::thread::current().name().unwrap_or("").to_string();
+        crate::cpu::current_tid().map(|tid| (name, tid))
+    })
+    .into_iter()
+    .flatten()
+    .collect()
 }
 
 impl Exec for PoolExec {
@@ -56,6 +71,11 @@ impl SplitExec {
             .thread_name(|i| SPLIT_NAMES[i].to_string())
             .build()?;
         Ok(SplitExec { pool })
+    }
+
+    /// `(name, kernel thread id)` of both threads (Linux).
+    pub fn thread_ids(&self) -> Vec<(String, i32)> {
+        thread_ids(&self.pool)
     }
 }
 
