@@ -79,6 +79,35 @@ impl Exec for SerialLanes {
     }
 }
 
+/// Functional decomposition on the calling thread, timing each job: how
+/// well `split`'s two threads could be balanced.
+#[derive(Default)]
+struct SerialJoin {
+    spent: Mutex<(f64, f64)>,
+}
+
+impl Exec for SerialJoin {
+    fn lanes(&self) -> usize {
+        1
+    }
+    fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
+        f(0)
+    }
+    fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {
+        let t0 = cpu_now();
+        a();
+        let t1 = cpu_now();
+        b();
+        let t2 = cpu_now();
+        let mut s = self.spent.lock();
+        s.0 += t1 - t0;
+        s.1 += t2 - t1;
+    }
+    fn functional(&self) -> bool {
+        true
+    }
+}
+
 /// The ball a sphere's path stays in during a step (as `swept` uses it).
 fn path_ball(s: &Sphere) -> (DVec3, f64) {
     (
@@ -150,6 +179,9 @@ fn phases(label: &str, world: &World) {
     }
     let build = (cpu_now() - t0 - *build_lanes.spent.lock()) / steps as f64;
     let (pairs, involved, count, largest) = clusters(&w);
+    let join = SerialJoin::default();
+    model.advance(&mut w.clone(), DT, steps, &join);
+    let (pair_job, wall_job) = *join.spent.lock();
     // What the engine adds per frame: the snapshot (views, energy, overlap).
     let mut e = Engine::new(w.clone(), settings(Threading::Off, 1, 0)).unwrap();
     let t0 = cpu_now();
@@ -162,7 +194,8 @@ fn phases(label: &str, world: &World) {
          pair search, wall search, flight) {:.1} ms + serial {:.1} ms (grid build, serial \
          part {:.1} ms; contact event loop with rescans {:.1} ms) => Amdahl bound for 2 threads {:.2}x; \
          {pairs} pairs meeting, {involved} of {} spheres in {count} clusters, largest {largest}; \
-         the engine's snapshot {:.1} ms per frame",
+         the engine's snapshot {:.1} ms per frame; split's jobs per step: \
+         sphere-sphere {:.2} ms beside sphere-wall {:.2} ms",
         total * 1e3,
         par * 1e3,
         (total - par) * 1e3,
@@ -171,6 +204,8 @@ fn phases(label: &str, world: &World) {
         total / (total - par + par / 2.0),
         w.spheres.len(),
         snapshot * 1e3,
+        pair_job / steps as f64 * 1e3,
+        wall_job / steps as f64 * 1e3,
     );
 }
 
