@@ -5,3 +5,4 @@ pub mod cpu;
 pub mod engine;
 pub mod error;
 pub mod physics;
+pub mod tui;

@@ -49,11 +49,12 @@ impl Grid {
         self.big.clear();
         self.all_pairs = n <= ALL_PAIRS_MAX;
         if self.all_pairs {
-            self.big.extend(spheres.iter().enumerate().map(|(i, s)| Entry {
-                pos: s.pos,
-                reach: reach(s),
-                id: i as u32,
-            }));
+            self.big
+                .extend(spheres.iter().enumerate().map(|(i, s)| Entry {
+                    pos: s.pos,
+                    reach: reach(s),
+                    id: i as u32,
+                }));
             return;
         }
         // Cell from the 98th percentile of reach: the bulk share few cells,
@@ -238,7 +239,11 @@ impl Grid {
 
     fn cell_coords(&self, p: DVec3) -> [usize; 3] {
         let c = |x: f64, n: usize| ((x * self.inv_cell).floor().max(0.0) as usize).min(n - 1);
-        [c(p.x, self.dims[0]), c(p.y, self.dims[1]), c(p.z, self.dims[2])]
+        [
+            c(p.x, self.dims[0]),
+            c(p.y, self.dims[1]),
+            c(p.z, self.dims[2]),
+        ]
     }
 }
 

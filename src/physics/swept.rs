@@ -203,11 +203,25 @@ impl Swept {
                 && t <= dt
             {
                 let (a, b) = (a.min(b), a.max(b));
-                self.heap.push(Event { t, a, b, ca: 0, cb: 0 });
+                self.heap.push(Event {
+                    t,
+                    a,
+                    b,
+                    ca: 0,
+                    cb: 0,
+                });
             }
         }
         for a in 0..m as u32 {
-            push_wall(&mut self.heap, &sp[self.involved[a as usize] as usize], a, 0.0, 0, size, dt);
+            push_wall(
+                &mut self.heap,
+                &sp[self.involved[a as usize] as usize],
+                a,
+                0.0,
+                0,
+                size,
+                dt,
+            );
         }
         let cap = 10_000 + 64 * m;
         let mut done = 0usize;
@@ -265,7 +279,11 @@ impl Swept {
                 && t + dtc <= dt
             {
                 let cb = self.count[b as usize];
-                let (x, y, cx, cy) = if a < b { (a, b, ca, cb) } else { (b, a, cb, ca) };
+                let (x, y, cx, cy) = if a < b {
+                    (a, b, ca, cb)
+                } else {
+                    (b, a, cb, ca)
+                };
                 self.heap.push(Event {
                     t: t + dtc,
                     a: x,
@@ -278,7 +296,15 @@ impl Swept {
     }
 }
 
-fn push_wall(heap: &mut BinaryHeap<Event>, s: &Sphere, a: u32, t: f64, ca: u32, size: f64, dt: f64) {
+fn push_wall(
+    heap: &mut BinaryHeap<Event>,
+    s: &Sphere,
+    a: u32,
+    t: f64,
+    ca: u32,
+    size: f64,
+    dt: f64,
+) {
     let (tw, _) = wall_toi(s, size);
     if t + tw <= dt {
         heap.push(Event {
