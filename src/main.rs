@@ -44,11 +44,13 @@ fn lattice_world(n: usize, radius: f64, speed: f64, seed: u64) -> World {
 fn main() {
     let mut opts = ballpit::tui::Options::default();
     let mut count = 1000;
+    let mut tick = 1;
     let args: Vec<String> = std::env::args().skip(1).collect();
     for pair in args.chunks(2) {
         match (pair[0].as_str(), pair.get(1)) {
             ("--fps", Some(v)) => opts.fps = v.parse().unwrap_or(f64::NAN),
             ("--count", Some(v)) => count = v.parse().unwrap_or(1000),
+            ("--tick", Some(v)) => tick = v.parse().unwrap_or(1),
             ("--color", Some(v)) => opts.color = v.parse().unwrap_or_default(),
             _ => {}
         }
@@ -57,7 +59,7 @@ fn main() {
     let settings = Settings {
         model: ModelKind::Swept,
         dt: 1.0 / 60.0,
-        tick: 1,
+        tick,
         threading: Threading::Off,
         threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
     };
