@@ -13,9 +13,9 @@ pub struct HelpBar {
 impl Widget for HelpBar {
     fn render(self, area: Rect, buf: &mut Buffer) {
         let mut spans = Vec::new();
-        for (keys, short, _) in KEYS {
-            spans.push(Span::styled(keys.to_string(), self.palette.key()));
-            spans.push(Span::raw(format!(" {short} ")));
+        for (key, label) in KEYS.iter().filter_map(|k| k.1) {
+            spans.push(Span::styled(key, self.palette.key()));
+            spans.push(Span::raw(format!(" {label} ")));
         }
         Paragraph::new(Line::from(spans)).render(area, buf);
     }

@@ -71,32 +71,45 @@ pub fn action(key: KeyEvent) -> Option<Action> {
     })
 }
 
-/// Every key with what it does, for the help bar and the `?` overlay.
-pub const KEYS: &[(&str, &str, &str)] = &[
-    // (keys, short label for the bar, description for the overlay)
-    ("q Esc ^C", "quit", "quit"),
+/// Every key with what it does: (keys, help-bar key and label, description
+/// for the `?` overlay). The bar leaves out what doesn't fit in 120 columns;
+/// `?` comes first so it is always there.
+pub const KEYS: &[(&str, Option<(&str, &str)>, &str)] = &[
+    ("?", Some(("?", "help")), "this help"),
+    ("q Esc ^C", Some(("q", "quit")), "quit"),
     (
         "t",
-        "threads",
+        Some(("t", "thread")),
         "threading on/off (off <-> last threaded mode)",
     ),
-    ("d", "mode", "cycle threaded mode: worker -> pool -> split"),
-    ("p/P", "pool", "pool threads - / +"),
-    ("[/]", "tick", "physics tick - / + (0 freezes)"),
-    ("space", "pause", "pause / resume"),
-    ("n/N", "count", "sphere count /2 / x2"),
-    ("r/R", "radius", "sphere radius smaller / bigger"),
-    ("m", "model", "cycle collision model"),
-    ("arrows", "camera", "rotate the camera"),
+    (
+        "d",
+        Some(("d", "mode")),
+        "cycle threaded mode: worker -> pool -> split",
+    ),
+    ("p/P", Some(("p/P", "pool")), "pool threads - / +"),
+    (
+        "[/]",
+        Some(("[/]", "tick")),
+        "physics tick - / + (0 freezes)",
+    ),
+    ("space", Some(("spc", "pause")), "pause / resume"),
+    ("n/N", Some(("n/N", "count")), "sphere count /2 / x2"),
+    (
+        "r/R",
+        Some(("r/R", "size")),
+        "sphere radius smaller / bigger",
+    ),
+    ("m", Some(("m", "model")), "cycle collision model"),
+    ("arrows", Some(("←→↑↓", "camera")), "rotate the camera"),
     (
         "v",
-        "style",
+        Some(("v", "style")),
         "cycle drawing style (braille / shaded blocks)",
     ),
-    ("l", "light", "move the light (shaded style)"),
-    ("f/F", "fps", "frame rate - / +"),
-    ("0", "reset", "reset the scene"),
-    ("?", "help", "this help"),
+    ("l", Some(("l", "light")), "move the light (shaded style)"),
+    ("0", Some(("0", "reset")), "reset the scene"),
+    ("f/F", None, "frame rate - / +"),
 ];
 
 #[cfg(test)]
