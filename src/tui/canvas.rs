@@ -82,7 +82,9 @@ pub struct Raster {
     depth: Vec<f32>,
     shade: Vec<u8>,
     level: Vec<u8>,
-    order: Vec<(Projected, u32)>,
+    projected: Vec<Projected>,
+    /// Far-to-near order: inverted depth bits above the sphere index.
+    order: Vec<u64>,
 }
 
 impl Raster {
@@ -133,19 +135,31 @@ impl Raster {
         // Twice the rms speed is "hot": a Maxwell gas spreads over the ramp.
         let hot = 2.0 * mean_sq.sqrt();
         let mut order = std::mem::take(&mut self.order);
+        let mut projected = std::mem::take(&mut self.projected);
         order.clear();
-        for (i, s) in spheres.iter().enumerate() {
-            if let Some(p) = proj.project(s.pos) {
-                order.push((p, i as u32));
+        projected.clear();
+        for s in spheres {
+            let p = proj.project(s.pos);
+            if let Some(p) = p {
+                // Depths are positive, so their bits sort like the numbers;
+                // inverted, the farthest comes first.
+                let key = !(p.depth as f32).to_bits();
+                order.push((u64::from(key) << 32) | projected.len() as u64);
             }
+            projected.push(p.unwrap_or(Projected {
+                x: 0.0,
+                y: 0.0,
+                depth: 0.0,
+                unit: 0.0,
+            }));
         }
-        // Far first: nearer discs paint over farther ones.
-        order.sort_unstable_by(|a, b| b.0.depth.total_cmp(&a.0.depth));
+        order.sort_unstable();
         let (pw, ph) = proj.pixel_size();
         let light = light_dir(scene.light);
         let ring = scene.style != DrawStyle::Shaded;
-        for &(p, i) in &order {
-            let s = &spheres[i as usize];
+        for &key in &order {
+            let i = (key & 0xffff_ffff) as usize;
+            let (s, p) = (&spheres[i], projected[i]);
             let t = match scene.style.ramp() {
                 Ramp::Speed if hot > 0.0 => s.speed / hot,
                 Ramp::Speed => 0.0,
@@ -156,6 +170,7 @@ impl Raster {
             self.disc(p.x, p.y, r / pw, r / ph, p.depth as f32, level, light, ring);
         }
         self.order = order;
+        self.projected = projected;
     }
 
     /// A disc with radii `rx`, `ry` in pixels (the same length on screen).
@@ -199,11 +214,14 @@ impl Raster {
                 let d2 = dx * dx + dy * dy;
                 let k = row + x as usize;
                 if d2 <= 1.0 {
-                    let nz = (1.0 - d2).sqrt();
-                    let lit = (dx * light[0] + dy * light[1] + nz * light[2]).max(0.0);
-                    let shade = 1.0 + (lit * f64::from(SHADES - 1)).round();
                     self.depth[k] = depth;
-                    self.shade[k] = if ring { SHADES } else { shade as u8 };
+                    self.shade[k] = if ring {
+                        SHADES
+                    } else {
+                        let nz = (1.0 - d2).sqrt();
+                        let lit = (dx * light[0] + dy * light[1] + nz * light[2]).max(0.0);
+                        1 + (lit * f64::from(SHADES - 1) + 0.5) as u8
+                    };
                     self.level[k] = level;
                 } else if ring {
                     let ex = (x as f64 + 0.5 - cx) / ox;
