@@ -32,7 +32,11 @@ fn lattice_world(n: usize, radius: f64, speed: f64, seed: u64) -> World {
         if spheres.len() == n {
             break;
         }
-        let idx = DVec3::new((i / side / side) as f64, (i / side % side) as f64, (i % side) as f64);
+        let idx = DVec3::new(
+            (i / side / side) as f64,
+            (i / side % side) as f64,
+            (i % side) as f64,
+        );
         let mut c = idx * cell + DVec3::splat(cell / 2.0);
         for a in 0..3 {
             c[a] += rng.random_range(-slack..=slack);
@@ -91,7 +95,10 @@ fn frames(world: World, frames: usize) -> Vec<Snapshot> {
 
 fn bench_frame(c: &mut Criterion) {
     let snaps = frames(lattice_world(10_000, 0.01, 0.5, 7), 2);
-    for (name, style) in [("braille", DrawStyle::PointsSpeed), ("shaded", DrawStyle::Shaded)] {
+    for (name, style) in [
+        ("braille", DrawStyle::PointsSpeed),
+        ("shaded", DrawStyle::Shaded),
+    ] {
         let mut st = AppState::new(&settings(), 10_000, 0.01, 30.0);
         st.style = style;
         let stats = Stats::default();
@@ -176,7 +183,11 @@ fn wire_bytes() {
         println!(
             "wire/120x40_1000_spheres_{}_{}: {:.0} B/frame, {:.1} KB/s at 30 fps (first frame {} B)",
             palette.name(),
-            if style == DrawStyle::Shaded { "shaded" } else { "braille" },
+            if style == DrawStyle::Shaded {
+                "shaded"
+            } else {
+                "braille"
+            },
             per_frame,
             per_frame * 30.0 / 1000.0,
             first

@@ -278,3 +278,57 @@ fn a_small_terminal_gets_told_how_big_it_must_be_and_resizing_recovers() {
     app.send("q");
     assert!(app.wait_exit(3.0).expect("q ends the app").success());
 }
+
+#[test]
+fn a_panic_in_another_thread_restores_the_terminal_then_prints_and_fails() {
+    let pty = native_pty_system()
+        .openpty(PtySize {
+            rows: 40,
+            cols: 120,
+            pixel_width: 0,
+            pixel_height: 0,
+        })
+        .unwrap();
+    let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_ballpit"));
+    cmd.env("TERM", "xterm-256color");
+    cmd.env("BALLPIT_TEST_PANIC_THREAD", "1");
+    cmd.env("RUST_BACKTRACE", "0");
+    let mut child = pty.slave.spawn_command(cmd).unwrap();
+    drop(pty.slave);
+    let mut reader = pty.master.try_clone_reader().unwrap();
+    let raw = Arc::new(Mutex::new(Vec::new()));
+    let r = raw.clone();
+    thread::spawn(move || {
+        let mut buf = [0u8; 65536];
+        while let Ok(n) = reader.read(&mut buf) {
+            if n == 0 {
+                break;
+            }
+            r.lock().unwrap().extend_from_slice(&buf[..n]);
+        }
+    });
+    let end = Instant::now() + Duration::from_secs(5);
+    let status = loop {
+        if let Some(st) = child.try_wait().unwrap() {
+            break st;
+        }
+        assert!(Instant::now() < end, "the panic did not end the app");
+        thread::sleep(Duration::from_millis(20));
+    };
+    assert!(!status.success());
+    thread::sleep(Duration::from_millis(200));
+    let out = String::from_utf8_lossy(&raw.lock().unwrap()).to_string();
+    let left = out.rfind("\x1b[?1049l").expect("left the alternate screen");
+    let msg = out
+        .find("test panic in a worker thread")
+        .expect("the panic message");
+    assert!(left < msg, "message printed after the restore");
+    let mut p = vt100::Parser::new(nz(40), nz(120), 0);
+    p.process(out.as_bytes());
+    assert!(!p.screen().alternate_screen());
+    assert!(
+        p.screen()
+            .contents()
+            .contains("test panic in a worker thread")
+    );
+}

@@ -58,6 +58,15 @@ pub fn run(world: World, settings: Settings, opts: Options) -> anyhow::Result<()
     let guard = Guard::enter(tx.clone()).context("cannot set up the terminal")?;
     let signals = guard::spawn_signals(tx.clone())?;
     guard::spawn_input(tx)?;
+    // For the end-to-end test of a panic off the main thread.
+    if std::env::var_os("BALLPIT_TEST_PANIC_THREAD").is_some() {
+        std::thread::Builder::new()
+            .name("test-panic".into())
+            .spawn(|| {
+                std::thread::sleep(Duration::from_millis(300));
+                panic!("test panic in a worker thread");
+            })?;
+    }
     let result = FrameLoop::new(engine, state, palette, detected).and_then(|l| l.run(rx));
     signals.close();
     drop(guard);
