@@ -47,10 +47,8 @@ fn start(args: &[&str], read_until: Option<&'static str>) -> App {
                 Ok(n) => {
                     let mut p = s.lock().unwrap();
                     p.process(&buf[..n]);
-                    if let Some(text) = read_until {
-                        if p.screen().contents().contains(text) {
-                            return;
-                        }
+                    if read_until.is_some_and(|t| p.screen().contents().contains(t)) {
+                        return;
                     }
                 }
             }
@@ -140,10 +138,12 @@ fn thread_loads(screen: &str) -> Vec<(String, f64)> {
             .trim_matches(|c| c == '│' || c == ' ')
             .split_whitespace()
             .collect();
-        if cells.len() >= 2 && cells[0] != "thread" && cells[0] != "total" {
-            if let Ok(p) = cells[1].parse::<f64>() {
-                out.push((cells[0].to_string(), p));
-            }
+        if cells.len() >= 2
+            && cells[0] != "thread"
+            && cells[0] != "total"
+            && let Ok(p) = cells[1].parse::<f64>()
+        {
+            out.push((cells[0].to_string(), p));
         }
     }
     out

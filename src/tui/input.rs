@@ -74,7 +74,10 @@ pub fn action(key: KeyEvent) -> Option<Action> {
 /// Every key with what it does: (keys, help-bar key and label, description
 /// for the `?` overlay). The bar leaves out what doesn't fit in 120 columns;
 /// `?` comes first so it is always there.
-pub const KEYS: &[(&str, Option<(&str, &str)>, &str)] = &[
+/// Key and label in the help bar, if it has room.
+pub type BarEntry = Option<(&'static str, &'static str)>;
+
+pub const KEYS: &[(&str, BarEntry, &str)] = &[
     ("?", Some(("?", "help")), "this help"),
     ("q Esc ^C", Some(("q", "quit")), "quit"),
     (
