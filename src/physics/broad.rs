@@ -129,10 +129,10 @@ impl Grid {
 
     /// Every pair within reach, in a fixed order (cell blocks, then the
     /// second level), found in parallel on `exec`; `keep` filters pairs.
-    pub fn pairs(
+    pub fn pairs<K: Fn(u32, u32) -> bool + Sync>(
         &mut self,
         exec: &dyn Exec,
-        keep: &(dyn Fn(u32, u32) -> bool + Sync),
+        keep: &K,
         out: &mut Vec<Pair>,
     ) {
         out.clear();
@@ -180,33 +180,94 @@ impl Grid {
         }
     }
 
+    /// Entries of the cells `x0..=x1` of row `(y, z)`: contiguous, since
+    /// keys run along x.
     #[inline]
-    fn range(&self, c: usize) -> &[Entry] {
-        &self.entries[self.cell_start[c] as usize..self.cell_start[c + 1] as usize]
+    fn row(&self, x0: usize, x1: usize, y: usize, z: usize) -> &[Entry] {
+        let [nx, ny, _] = self.dims;
+        let base = nx * (y + ny * z);
+        &self.entries[self.cell_start[base + x0] as usize..self.cell_start[base + x1 + 1] as usize]
     }
 
     /// Pairs with at least one sphere in cell `c`, each found once: the cell
-    /// with itself and its 13 forward neighbours.
+    /// with itself and its 13 forward neighbours, read as 5 row ranges.
     fn cell_pairs(&self, c: usize, f: &mut impl FnMut(u32, u32)) {
-        let here = self.range(c);
-        if here.is_empty() {
+        let (lo, hi) = (self.cell_start[c] as usize, self.cell_start[c + 1] as usize);
+        if lo == hi {
             return;
-        }
-        for (k, a) in here.iter().enumerate() {
-            for b in &here[k + 1..] {
-                test(a, b, f);
-            }
         }
         let [nx, ny, nz] = self.dims;
         let (x, y, z) = (c % nx, (c / nx) % ny, c / (nx * ny));
-        for &(dx, dy, dz) in &FORWARD {
-            let (xx, yy, zz) = (x as isize + dx, y as isize + dy, z as isize + dz);
-            if xx < 0 || yy < 0 || xx >= nx as isize || yy >= ny as isize || zz >= nz as isize {
+        let here = &self.entries[lo..hi];
+        // Same row: the rest of this cell and the next one along x.
+        let row_end = if x + 1 < nx {
+            self.cell_start[c + 2] as usize
+        } else {
+            hi
+        };
+        for (k, a) in here.iter().enumerate() {
+            for b in &self.entries[lo + k + 1..row_end] {
+                test(a, b, f);
+            }
+        }
+        let (x0, x1) = (x.saturating_sub(1), (x + 1).min(nx - 1));
+        let mut rows = [(0usize, 0usize); 4];
+        let mut count = 0;
+        if y + 1 < ny {
+            rows[count] = (y + 1, z);
+            count += 1;
+        }
+        if z + 1 < nz {
+            for yy in y.saturating_sub(1)..=(y + 1).min(ny - 1) {
+                rows[count] = (yy, z + 1);
+                count += 1;
+            }
+        }
+        for &(yy, zz) in &rows[..count] {
+            let other = self.row(x0, x1, yy, zz);
+            if other.is_empty() {
                 continue;
             }
-            let other = self.range(xx as usize + nx * (yy as usize + ny * zz as usize));
             for a in here {
                 for b in other {
+                    test(a, b, f);
+                }
+            }
+        }
+    }
+
+    /// Every sphere (either level) that may lie within `span` of `p`, as
+    /// `f(id, centre, reach)`: all of the second level, and the grid cells
+    /// that cover `p ± span`. The caller applies its own test.
+    pub fn near(&self, p: DVec3, span: f64, f: &mut impl FnMut(u32, DVec3, f64)) {
+        if !self.all_pairs && !self.entries.is_empty() {
+            let lo = self.cell_coords(p - DVec3::splat(span));
+            let hi = self.cell_coords(p + DVec3::splat(span));
+            for z in lo[2]..=hi[2] {
+                for y in lo[1]..=hi[1] {
+                    for b in self.row(lo[0], hi[0], y, z) {
+                        f(b.id, b.pos, b.reach);
+                    }
+                }
+            }
+        }
+        for b in &self.big {
+            f(b.id, b.pos, b.reach);
+        }
+    }
+
+    /// Largest reach among first-level (grid) spheres.
+    pub fn small_reach(&self) -> f64 {
+        self.small_reach_max
+    }
+
+    fn grid_near(&self, a: &Entry, f: &mut impl FnMut(u32, u32)) {
+        let span = a.reach + self.small_reach_max;
+        let lo = self.cell_coords(a.pos - DVec3::splat(span));
+        let hi = self.cell_coords(a.pos + DVec3::splat(span));
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                for b in self.row(lo[0], hi[0], y, z) {
                     test(a, b, f);
                 }
             }
@@ -218,19 +279,7 @@ impl Grid {
     fn big_pairs(&self, k: usize, f: &mut impl FnMut(u32, u32)) {
         let a = &self.big[k];
         if !self.all_pairs && !self.entries.is_empty() {
-            let span = a.reach + self.small_reach_max;
-            let lo = self.cell_coords(a.pos - DVec3::splat(span));
-            let hi = self.cell_coords(a.pos + DVec3::splat(span));
-            let [nx, ny, _] = self.dims;
-            for z in lo[2]..=hi[2] {
-                for y in lo[1]..=hi[1] {
-                    for x in lo[0]..=hi[0] {
-                        for b in self.range(x + nx * (y + ny * z)) {
-                            test(a, b, f);
-                        }
-                    }
-                }
-            }
+            self.grid_near(a, f);
         }
         for b in &self.big[k + 1..] {
             test(a, b, f);
@@ -255,22 +304,6 @@ fn test(a: &Entry, b: &Entry, f: &mut impl FnMut(u32, u32)) {
     }
 }
 
-const FORWARD: [(isize, isize, isize); 13] = [
-    (1, 0, 0),
-    (-1, 1, 0),
-    (0, 1, 0),
-    (1, 1, 0),
-    (-1, -1, 1),
-    (0, -1, 1),
-    (1, -1, 1),
-    (-1, 0, 1),
-    (0, 0, 1),
-    (1, 0, 1),
-    (-1, 1, 1),
-    (0, 1, 1),
-    (1, 1, 1),
-];
-
 fn ensure_slots<T>(slots: &mut Vec<Mutex<Vec<T>>>, n: usize) {
     while slots.len() < n {
         slots.push(Mutex::new(Vec::new()));
@@ -283,7 +316,7 @@ pub fn for_each_near_pair(spheres: &[Sphere], size: f64, mut f: impl FnMut(usize
     let mut grid = Grid::default();
     grid.build(spheres, size, |s| s.radius);
     let mut out = Vec::new();
-    grid.pairs(&super::exec::Serial, &|_, _| true, &mut out);
+    grid.pairs(&super::exec::Serial, &|_: u32, _: u32| true, &mut out);
     for (i, j) in out {
         f(i as usize, j as usize);
     }
