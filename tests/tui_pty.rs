@@ -123,21 +123,17 @@ fn thread_loads(screen: &str) -> Vec<(String, f64)> {
     let mut out = Vec::new();
     let mut in_panel = false;
     for l in screen.lines() {
-        let Some(i) = l.rfind("┌").or_else(|| l.rfind("│")) else {
-            continue;
-        };
-        let row = &l[i..];
-        if row.contains("threads: CPU %") {
+        if l.contains("threads: CPU %") {
             in_panel = true;
             continue;
         }
-        if !in_panel {
+        // The panel's row is what lies between its two borders.
+        let parts: Vec<&str> = l.split('│').collect();
+        if !in_panel || parts.len() < 3 {
             continue;
         }
-        let cells: Vec<&str> = row
-            .trim_matches(|c| c == '│' || c == ' ')
-            .split_whitespace()
-            .collect();
+        let row = parts[parts.len() - 2];
+        let cells: Vec<&str> = row.split_whitespace().collect();
         if cells.len() >= 2
             && cells[0] != "thread"
             && cells[0] != "total"
