@@ -43,7 +43,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 None => ballpit::tui::ColorChoice::Auto,
                 Some(c) => c.parse().map_err(BadInput)?,
             };
-            let opts = ballpit::tui::Options { fps: cli.fps, color };
+            let opts = ballpit::tui::Options {
+                fps: cli.fps,
+                color,
+            };
             ballpit::tui::run(world, settings, opts)
         }
     }

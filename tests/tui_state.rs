@@ -241,3 +241,28 @@ fn threading_given_on_the_command_line_is_what_t_returns_to() {
     key(&mut a, KeyCode::Char('t'));
     assert_eq!(a.threading, Threading::Split);
 }
+
+#[test]
+fn sync_takes_the_real_count_radius_and_the_engine_notice() {
+    use ballpit::engine::Engine;
+    use ballpit::physics::{Sphere, World};
+    use glam::DVec3;
+    let spheres = vec![
+        Sphere::new(DVec3::splat(0.3), DVec3::X, 0.05),
+        Sphere::new(DVec3::splat(0.7), DVec3::Y, 0.1),
+    ];
+    let engine = Engine::new(World::new(1.0, spheres), settings()).unwrap();
+    let mut snap = engine.snapshot().clone();
+    let mut a = app();
+    key(&mut a, KeyCode::Char('N'));
+    snap.notice = Some("count limit: no free space".into());
+    a.sync(&snap, true);
+    assert_eq!((a.count, a.radius), (2, 0.1));
+    assert_eq!(a.notice.as_deref(), Some("count limit: no free space"));
+    // A frame that applied nothing of ours leaves the notice alone.
+    snap.notice = None;
+    a.sync(&snap, false);
+    assert!(a.notice.is_some());
+    a.sync(&snap, true);
+    assert!(a.notice.is_none());
+}

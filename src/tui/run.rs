@@ -217,6 +217,7 @@ impl FrameLoop {
     /// One frame: start the physics of the next, draw the last, finish.
     fn frame(&mut self) -> anyhow::Result<()> {
         let step = self.state.running() || self.pending;
+        let applied = self.pending;
         if step {
             let tick = if self.state.running() {
                 self.state.tick
@@ -236,7 +237,7 @@ impl FrameLoop {
         if step {
             let snap = self.engine.finish_frame()?;
             self.window.steps += snap.steps;
-            self.state.sync(snap);
+            self.state.sync(snap, applied);
             self.dirty = true;
         }
         Ok(())

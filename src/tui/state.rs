@@ -188,14 +188,15 @@ impl AppState {
     }
 
     /// Take what the engine really did (count and radius may stop at a
-    /// limit; reset restores the scene).
-    pub fn sync(&mut self, snap: &Snapshot) {
+    /// limit; reset restores the scene). `applied`: this frame applied our
+    /// commands, so its notice (or the lack of one) answers them.
+    pub fn sync(&mut self, snap: &Snapshot, applied: bool) {
         self.count = snap.spheres.len();
         if let Some(r) = representative_radius(snap) {
             self.radius = r;
         }
-        if let Some(n) = &snap.notice {
-            self.notice = Some(n.clone());
+        if applied {
+            self.notice.clone_from(&snap.notice);
         }
     }
 }
