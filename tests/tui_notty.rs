@@ -22,3 +22,19 @@ fn without_a_tty_it_suggests_bench_and_exits_2() {
         String::from_utf8_lossy(&out.stdout)
     );
 }
+
+#[test]
+fn a_bad_fps_or_colour_is_bad_input() {
+    for (flag, value, says) in [("--fps", "0", "--fps"), ("--color", "99", "colour")] {
+        let out = Command::cargo_bin("ballpit")
+            .unwrap()
+            .args([flag, value])
+            .write_stdin("")
+            .timeout(std::time::Duration::from_secs(10))
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{flag} {value}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(says), "{err}");
+    }
+}

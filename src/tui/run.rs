@@ -25,19 +25,19 @@ const SAMPLE_PERIOD: Duration = Duration::from_secs(1);
 
 /// Open the screen on `world` and run until the user quits.
 pub fn run(world: World, settings: Settings, opts: Options) -> anyhow::Result<()> {
+    if !(opts.fps.is_finite() && opts.fps > 0.0 && opts.fps <= 1000.0) {
+        return Err(BadInput(format!(
+            "--fps must be between 0 and 1000, got {}",
+            opts.fps
+        ))
+        .into());
+    }
     if !(io::stdin().is_terminal() && io::stdout().is_terminal()) {
         return Err(BadInput(
             "ballpit's screen needs a terminal, but stdin or stdout is not one; \
              for a headless run use `ballpit bench`"
                 .into(),
         )
-        .into());
-    }
-    if !(opts.fps.is_finite() && opts.fps > 0.0 && opts.fps <= 1000.0) {
-        return Err(BadInput(format!(
-            "--fps must be between 0 and 1000, got {}",
-            opts.fps
-        ))
         .into());
     }
     let env = |k: &str| std::env::var(k).ok();
@@ -90,6 +90,8 @@ struct FrameLoop {
     sent_tick: u32,
     /// Commands sent that no frame has applied yet.
     pending: bool,
+    /// A frame was started and not finished; whether it applied commands.
+    in_flight: Option<bool>,
     /// Something on screen would change.
     dirty: bool,
     window: Window,
@@ -135,6 +137,7 @@ impl FrameLoop {
             aspect: cell_aspect(),
             sent_tick,
             pending: false,
+            in_flight: None,
             dirty: true,
             window: Window {
                 start: Instant::now(),
@@ -149,7 +152,8 @@ impl FrameLoop {
         let mut next_frame = Instant::now();
         let mut next_sample = Instant::now() + SAMPLE_PERIOD;
         loop {
-            let wants_frame = self.state.running() || self.pending || self.dirty;
+            let wants_frame =
+                self.state.running() || self.pending || self.dirty || self.in_flight.is_some();
             let deadline = if wants_frame {
                 next_frame.min(next_sample)
             } else {
@@ -214,11 +218,18 @@ impl FrameLoop {
         }
     }
 
-    /// One frame: start the physics of the next, draw the last, finish.
+    /// One frame: collect the physics started last frame, start the next,
+    /// and draw while it computes. The physics thus has the whole frame
+    /// period, the drawing and the wait for keys included, and the loop
+    /// only waits for it when it is slower than the frame rate.
     fn frame(&mut self) -> anyhow::Result<()> {
-        let step = self.state.running() || self.pending;
-        let applied = self.pending;
-        if step {
+        if let Some(applied) = self.in_flight.take() {
+            let snap = self.engine.finish_frame()?;
+            self.window.steps += snap.steps;
+            self.state.sync(snap, applied);
+            self.dirty = true;
+        }
+        if self.state.running() || self.pending {
             let tick = if self.state.running() {
                 self.state.tick
             } else {
@@ -229,16 +240,11 @@ impl FrameLoop {
                 self.sent_tick = tick;
             }
             self.engine.start_frame()?;
+            self.in_flight = Some(self.pending);
             self.pending = false;
         }
         if self.dirty {
             self.draw()?;
-        }
-        if step {
-            let snap = self.engine.finish_frame()?;
-            self.window.steps += snap.steps;
-            self.state.sync(snap, applied);
-            self.dirty = true;
         }
         Ok(())
     }
