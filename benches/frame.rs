@@ -2,7 +2,8 @@
 //!
 //! - `frame/10k_spheres_200x60_*`: projection, raster, ratatui diff and the
 //!   terminal bytes for one frame of 10 000 moving spheres at 200×60
-//!   (target < 4 ms).
+//!   (target < 4 ms); `frame_cpu/...` prints the same on-CPU time alone,
+//!   from the thread's schedstat, for shared machines.
 //! - then prints bytes per second at 120×40 for the default scene at 30 fps,
 //!   in 16 colours (target < 150 KB/s) and in truecolor.
 use ballpit::cpu::CpuReport;
@@ -195,10 +196,63 @@ fn wire_bytes() {
     }
 }
 
+/// On-CPU and run-queue nanoseconds of this thread so far (Linux
+/// schedstat): on a shared machine the wall-clock figures above include
+/// time spent waiting for a core; this says what a frame itself costs.
+fn schedstat() -> Option<(u64, u64)> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let mut it = s.split_whitespace().map(|v| v.parse::<u64>().ok());
+    Some((it.next()??, it.next()??))
+}
+
+fn frame_cpu() {
+    let snaps = frames(lattice_world(10_000, 0.01, 0.5, 7), 2);
+    for (name, style) in [
+        ("braille", DrawStyle::PointsSpeed),
+        ("shaded", DrawStyle::Shaded),
+    ] {
+        let mut st = AppState::new(&settings(), 10_000, 0.01, 30.0);
+        st.style = style;
+        let (stats, report) = (Stats::default(), CpuReport::default());
+        let (mut t, _) = terminal(200, 60);
+        let mut raster = Raster::new();
+        let n = 400;
+        let mut run = |k: usize| {
+            let view = View {
+                state: &st,
+                snap: &snaps[k % 2],
+                stats: &stats,
+                report: &report,
+                palette: Palette::C16,
+                aspect: 2.0,
+            };
+            frame(&mut t, &mut raster, &view);
+        };
+        for k in 0..20 {
+            run(k);
+        }
+        let wall = std::time::Instant::now();
+        let Some((cpu0, wait0)) = schedstat() else {
+            return;
+        };
+        for k in 0..n {
+            run(k);
+        }
+        let (cpu1, wait1) = schedstat().unwrap();
+        println!(
+            "frame_cpu/10k_spheres_200x60_{name}: {:.2} ms on CPU per frame ({:.2} ms wall, {:.2} ms waiting for a core)",
+            (cpu1 - cpu0) as f64 / n as f64 / 1e6,
+            wall.elapsed().as_secs_f64() / n as f64 * 1e3,
+            (wait1 - wait0) as f64 / n as f64 / 1e6,
+        );
+    }
+}
+
 criterion_group!(benches, bench_frame);
 
 fn main() {
     wire_bytes();
+    frame_cpu();
     benches();
     Criterion::default().configure_from_args().final_summary();
 }

@@ -202,9 +202,13 @@ fn v_cycles_the_styles_and_l_moves_the_light_round() {
     assert_eq!(a.style, DrawStyle::Shaded);
     key(&mut a, KeyCode::Char('v'));
     assert_eq!(a.style, DrawStyle::PointsSpeed);
-    for i in 1..=LIGHT_STEPS {
+    key(&mut a, KeyCode::Char('l'));
+    assert!(a.notice.as_deref().unwrap().contains("shaded"));
+    a.style = DrawStyle::Shaded;
+    for i in 2..=LIGHT_STEPS + 1 {
         key(&mut a, KeyCode::Char('l'));
         assert_eq!(a.light, i % LIGHT_STEPS);
+        assert!(a.notice.is_none());
     }
 }
 

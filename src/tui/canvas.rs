@@ -165,7 +165,7 @@ impl Raster {
                 Ramp::Speed => 0.0,
                 Ramp::Depth => 1.0 - (p.depth - near) / (far - near),
             };
-            let level = (t.clamp(0.0, 1.0) * f64::from(RAMP_LEVELS - 1)).round() as u8;
+            let level = (t.clamp(0.0, 1.0) * f64::from(RAMP_LEVELS - 1) + 0.5) as u8;
             let r = s.radius * p.unit; // cell widths
             self.disc(p.x, p.y, r / pw, r / ph, p.depth as f32, level, light, ring);
         }
@@ -189,7 +189,7 @@ impl Raster {
         let (w, h) = (self.w as isize, self.h as isize);
         if rx < 0.75 || ry < 0.75 {
             // Smaller than a pixel: one point.
-            let (x, y) = (cx.floor() as isize, cy.floor() as isize);
+            let (x, y) = (floor(cx), floor(cy));
             if x >= 0 && y >= 0 && x < w && y < h {
                 let k = y as usize * self.w + x as usize;
                 self.depth[k] = depth;
@@ -202,34 +202,52 @@ impl Raster {
         // every pixel has a single colour (braille).
         let gap = if ring { 1.0 } else { 0.0 };
         let (ox, oy) = (rx + gap, ry + gap);
-        let x0 = ((cx - ox).floor() as isize).max(0);
-        let x1 = ((cx + ox).ceil() as isize).min(w - 1);
-        let y0 = ((cy - oy).floor() as isize).max(0);
-        let y1 = ((cy + oy).ceil() as isize).min(h - 1);
+        let y0 = floor(cy - oy).max(0);
+        let y1 = ceil(cy + oy).min(h - 1);
+        let (irx, iry, ioy) = (1.0 / rx, 1.0 / ry, 1.0 / oy);
+        // Pixel x (centre x + 0.5) is within half-width `hw` of the centre
+        // for x in this range, clipped to the raster.
+        let span = |hw: f64| {
+            let lo = ceil(cx - hw - 0.5).max(0);
+            let hi = floor(cx + hw - 0.5).min(w - 1);
+            (lo, hi)
+        };
         for y in y0..=y1 {
-            let dy = (y as f64 + 0.5 - cy) / ry;
+            let fy = y as f64 + 0.5 - cy;
+            let ey = fy * ioy;
+            if ey * ey > 1.0 {
+                continue;
+            }
+            let dy = fy * iry;
             let row = y as usize * self.w;
-            for x in x0..=x1 {
-                let dx = (x as f64 + 0.5 - cx) / rx;
-                let d2 = dx * dx + dy * dy;
-                let k = row + x as usize;
-                if d2 <= 1.0 {
+            let (i0, i1) = if dy * dy <= 1.0 {
+                span(rx * (1.0 - dy * dy).sqrt())
+            } else {
+                (isize::MAX, isize::MIN)
+            };
+            if ring {
+                // Clear the gap on both sides of the disc, then fill it.
+                let (o0, o1) = span(ox * (1.0 - ey * ey).sqrt());
+                for x in (o0..=o1).filter(|x| *x < i0 || *x > i1) {
+                    let k = row + x as usize;
                     self.depth[k] = depth;
-                    self.shade[k] = if ring {
-                        SHADES
-                    } else {
-                        let nz = (1.0 - d2).sqrt();
-                        let lit = (dx * light[0] + dy * light[1] + nz * light[2]).max(0.0);
-                        1 + (lit * f64::from(SHADES - 1) + 0.5) as u8
-                    };
+                    self.shade[k] = EMPTY;
+                }
+                for x in i0..=i1 {
+                    let k = row + x as usize;
+                    self.depth[k] = depth;
+                    self.shade[k] = SHADES;
                     self.level[k] = level;
-                } else if ring {
-                    let ex = (x as f64 + 0.5 - cx) / ox;
-                    let ey = (y as f64 + 0.5 - cy) / oy;
-                    if ex * ex + ey * ey <= 1.0 {
-                        self.depth[k] = depth;
-                        self.shade[k] = EMPTY;
-                    }
+                }
+            } else {
+                for x in i0..=i1 {
+                    let dx = (x as f64 + 0.5 - cx) * irx;
+                    let nz = (1.0 - dx * dx - dy * dy).max(0.0).sqrt();
+                    let lit = (dx * light[0] + dy * light[1] + nz * light[2]).max(0.0);
+                    let k = row + x as usize;
+                    self.depth[k] = depth;
+                    self.shade[k] = 1 + (lit * f64::from(SHADES - 1) + 0.5) as u8;
+                    self.level[k] = level;
                 }
             }
         }
@@ -250,7 +268,7 @@ impl Raster {
                 // linear at this size; a small bias keeps edges over spheres
                 // that touch the wall.
                 let d = (pa.depth + (pb.depth - pa.depth) * f) as f32 - 1e-3;
-                let (xi, yi) = (x.floor() as isize, y.floor() as isize);
+                let (xi, yi) = (floor(x), floor(y));
                 if xi < 0 || yi < 0 || xi >= self.w as isize || yi >= self.h as isize {
                     continue;
                 }
@@ -343,6 +361,18 @@ impl Raster {
             }
         }
     }
+}
+
+// `f64::floor` and `ceil` are library calls on baseline x86-64; these are
+// a cast and a compare, and they are most of the cost of a small disc.
+fn floor(v: f64) -> isize {
+    let i = v as isize;
+    if (i as f64) > v { i - 1 } else { i }
+}
+
+fn ceil(v: f64) -> isize {
+    let i = v as isize;
+    if (i as f64) < v { i + 1 } else { i }
 }
 
 /// Unit light direction in screen space (x right, y down, z to the viewer),

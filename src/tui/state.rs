@@ -170,7 +170,12 @@ impl AppState {
             Action::Up => self.camera.pitch = (self.camera.pitch + CAMERA_STEP).min(MAX_PITCH),
             Action::Down => self.camera.pitch = (self.camera.pitch - CAMERA_STEP).max(-MAX_PITCH),
             Action::CycleStyle => self.style = self.style.next(),
-            Action::MoveLight => self.light = (self.light + 1) % LIGHT_STEPS,
+            Action::MoveLight => {
+                self.light = (self.light + 1) % LIGHT_STEPS;
+                if self.style != DrawStyle::Shaded {
+                    self.notice = Some("the light shows in the shaded style (v)".into());
+                }
+            }
             Action::Reset => out.push(Command::Reset),
             Action::Help => self.help = !self.help,
             Action::SlowerFps => match FPS_STEPS.iter().rev().find(|&&f| f < self.fps - 1e-9) {
