@@ -26,10 +26,11 @@ pub struct HelpOverlay {
 }
 
 impl HelpOverlay {
+    /// Rows are " key       description": 11 columns, the text, one spare.
     pub fn size() -> (u16, u16) {
         let w = KEYS
             .iter()
-            .map(|(k, _, d)| 10 + k.len() + d.len())
+            .map(|(_, _, d)| 12 + d.len())
             .max()
             .unwrap_or(40);
         (w as u16 + 2, KEYS.len() as u16 + 4)
