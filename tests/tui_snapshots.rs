@@ -42,6 +42,7 @@ fn snapshot() -> Snapshot {
 fn stats() -> Stats {
     Stats {
         fps: 29.9,
+        physics_seconds: 0.00123,
         render_seconds: 0.00087,
         frame_bytes: 4321,
         steps_per_second: 30.0,

@@ -13,9 +13,11 @@ use ratatui::widgets::{Block, Paragraph, Widget};
 pub struct Stats {
     /// Frames drawn per second, over the last second.
     pub fps: f64,
-    /// Building and writing the last frame, seconds.
+    /// Physics per frame, seconds (mean over the last second).
+    pub physics_seconds: f64,
+    /// Building and writing a frame, seconds (mean over the last second).
     pub render_seconds: f64,
-    /// Bytes written to the terminal for the last frame.
+    /// Bytes written to the terminal per frame (mean over the last second).
     pub frame_bytes: u64,
     pub steps_per_second: f64,
     pub collisions_per_second: f64,
@@ -80,7 +82,7 @@ impl Readouts<'_> {
             row("fps", format!("{:<8.1} target {}", st.fps, s.fps)),
             row(
                 "physics",
-                format!("{:<8.2} ms/frame", snap.physics_seconds * 1e3),
+                format!("{:<8.2} ms/frame", st.physics_seconds * 1e3),
             ),
             row(
                 "render",

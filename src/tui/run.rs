@@ -98,11 +98,16 @@ struct FrameLoop {
 }
 
 /// Counts over the current one-second window for the per-second figures.
+#[derive(Default)]
 struct Window {
-    start: Instant,
+    start: Option<Instant>,
     frames: u32,
     steps: u64,
     collisions_at_start: u64,
+    physics_frames: u32,
+    physics_seconds: f64,
+    render_seconds: f64,
+    bytes: u64,
 }
 
 impl FrameLoop {
@@ -140,10 +145,9 @@ impl FrameLoop {
             in_flight: None,
             dirty: true,
             window: Window {
-                start: Instant::now(),
-                frames: 0,
-                steps: 0,
+                start: Some(Instant::now()),
                 collisions_at_start: collisions,
+                ..Window::default()
             },
         })
     }
@@ -226,6 +230,8 @@ impl FrameLoop {
         if let Some(applied) = self.in_flight.take() {
             let snap = self.engine.finish_frame()?;
             self.window.steps += snap.steps;
+            self.window.physics_frames += 1;
+            self.window.physics_seconds += snap.physics_seconds;
             self.state.sync(snap, applied);
             self.dirty = true;
         }
@@ -267,8 +273,8 @@ impl FrameLoop {
         let backend = self.terminal.backend_mut();
         backend.write_all(END_SYNC)?;
         Backend::flush(backend)?;
-        self.stats.render_seconds = t0.elapsed().as_secs_f64();
-        self.stats.frame_bytes = self.bytes.load(Ordering::Relaxed) - before;
+        self.window.render_seconds += t0.elapsed().as_secs_f64();
+        self.window.bytes += self.bytes.load(Ordering::Relaxed) - before;
         self.window.frames += 1;
         self.dirty = false;
         Ok(())
@@ -276,20 +282,29 @@ impl FrameLoop {
 
     fn sample(&mut self, now: Instant) {
         self.report = self.sampler.sample().clone();
+        // Figures are per-second averages: they read better than values
+        // that change every frame, and they cost bytes only once a second.
+        let w = &self.window;
         let secs = now
-            .duration_since(self.window.start)
+            .duration_since(w.start.unwrap_or(now))
             .as_secs_f64()
             .max(1e-9);
         let total = collisions(self.engine.snapshot());
-        self.stats.fps = f64::from(self.window.frames) / secs;
-        self.stats.steps_per_second = self.window.steps as f64 / secs;
-        self.stats.collisions_per_second =
-            total.saturating_sub(self.window.collisions_at_start) as f64 / secs;
+        let st = &mut self.stats;
+        st.fps = f64::from(w.frames) / secs;
+        st.steps_per_second = w.steps as f64 / secs;
+        st.collisions_per_second = total.saturating_sub(w.collisions_at_start) as f64 / secs;
+        if w.frames > 0 {
+            st.render_seconds = w.render_seconds / f64::from(w.frames);
+            st.frame_bytes = w.bytes / u64::from(w.frames);
+        }
+        if w.physics_frames > 0 {
+            st.physics_seconds = w.physics_seconds / f64::from(w.physics_frames);
+        }
         self.window = Window {
-            start: now,
-            frames: 0,
-            steps: 0,
+            start: Some(now),
             collisions_at_start: total,
+            ..Window::default()
         };
         self.dirty = true;
     }
