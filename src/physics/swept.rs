@@ -36,7 +36,8 @@ pub struct Swept {
     involved: Vec<u32>,
     t_local: Vec<f64>,
     count: Vec<u32>,
-    start: Vec<DVec3>,
+    /// Each sphere's ball for the step: it stays within `reach` of `centre`.
+    centre: Vec<DVec3>,
     reach: Vec<f64>,
     grown: Vec<u32>,
     heap: BinaryHeap<Event>,
@@ -73,9 +74,16 @@ impl Ord for Event {
     }
 }
 
+/// The ball a sphere on a straight path stays in during the step: centred
+/// on the middle of its path, half the path plus its radius wide (an eighth
+/// of the volume of the ball around the start point).
 #[inline]
-fn start_reach(s: &Sphere, dt: f64) -> f64 {
-    (s.radius + s.vel.length() * dt) * REACH_SLACK
+fn path_ball(s: &Sphere, dt: f64) -> (DVec3, f64) {
+    let half = 0.5 * dt;
+    (
+        s.pos + s.vel * half,
+        (s.radius + s.vel.length() * half) * REACH_SLACK,
+    )
 }
 
 impl Model for Swept {
@@ -96,7 +104,7 @@ impl Swept {
         let size = world.size;
         let n = world.spheres.len();
         self.grid
-            .build(&world.spheres, size, |s| start_reach(s, dt));
+            .build(&world.spheres, size, |s| path_ball(s, dt), exec);
         let blocks = n.div_ceil(SPHERE_BLOCK);
         while self.wall_slots.len() < blocks {
             self.wall_slots.push(Mutex::new(Vec::new()));
@@ -163,8 +171,9 @@ impl Swept {
         self.involved.push(i);
         self.t_local.push(0.0);
         self.count.push(0);
-        self.start.push(s.pos);
-        self.reach.push(start_reach(s, dt));
+        let (centre, reach) = path_ball(s, dt);
+        self.centre.push(centre);
+        self.reach.push(reach);
         push_wall(&mut self.heap, s, l, 0.0, 0, size, dt);
         l
     }
@@ -180,7 +189,7 @@ impl Swept {
         self.involved.clear();
         self.t_local.clear();
         self.count.clear();
-        self.start.clear();
+        self.centre.clear();
         self.reach.clear();
         self.grown.clear();
         self.heap.clear();
@@ -251,7 +260,7 @@ impl Swept {
         let la = a as usize;
         let ia = self.involved[la] as usize;
         let sa = sp[ia];
-        let need = ((sa.pos - self.start[la]).length() + sa.vel.length() * (dt - t) + sa.radius)
+        let need = ((sa.pos - self.centre[la]).length() + sa.vel.length() * (dt - t) + sa.radius)
             * REACH_SLACK;
         // Grid spheres may grow up to `small` and still be found through the
         // cells; beyond that they join `grown`, which every rescan checks.
@@ -264,7 +273,7 @@ impl Swept {
         }
         let ca = self.count[la];
         push_wall(&mut self.heap, &sa, a, t, ca, size, dt);
-        let (p0, ra) = (self.start[la], self.reach[la]);
+        let (p0, ra) = (self.centre[la], self.reach[la]);
         let mut found = std::mem::take(&mut self.found);
         found.clear();
         let local = &self.local;
@@ -281,7 +290,7 @@ impl Swept {
         self.grid.near(p0, ra + small, &mut consider);
         for &g in &self.grown {
             let lg = g as usize;
-            consider(self.involved[lg], self.start[lg], self.reach[lg]);
+            consider(self.involved[lg], self.centre[lg], self.reach[lg]);
         }
         found.sort_unstable();
         found.dedup();
