@@ -147,7 +147,8 @@ fn bench_frame(c: &mut Criterion) {
 
 /// Bytes written per second at 120×40, default scene, 30 fps, 3 seconds.
 fn wire_bytes() {
-    let snaps = frames(lattice_world(1000, 0.02, 0.5, 1), 90);
+    let default_scene = ballpit::scene::build_world(&Default::default()).unwrap();
+    let snaps = frames(default_scene, 90);
     for (palette, style) in [
         (Palette::C16, DrawStyle::PointsSpeed),
         (Palette::True, DrawStyle::PointsSpeed),
@@ -182,7 +183,7 @@ fn wire_bytes() {
         let steady = bytes.load(Ordering::Relaxed) - first;
         let per_frame = steady as f64 / (snaps.len() - 1) as f64;
         println!(
-            "wire/120x40_1000_spheres_{}_{}: {:.0} B/frame, {:.1} KB/s at 30 fps (first frame {} B)",
+            "wire/120x40_default_scene_{}_{}: {:.0} B/frame, {:.1} KB/s at 30 fps (first frame {} B)",
             palette.name(),
             if style == DrawStyle::Shaded {
                 "shaded"

@@ -183,6 +183,15 @@ fn readouts_threading_tick_and_quit_in_a_real_terminal() {
             "{s}"
         );
     }
+    // Frames are paced at --fps (30 by default): never faster.
+    let s = app.wait_for("an fps figure", 4.0, |s| {
+        readout(s, "fps").is_some_and(|v| !v.starts_with("0.0 "))
+    });
+    let fps: f64 = readout(&s, "fps")
+        .and_then(|v| v.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+        .expect("fps readout");
+    assert!((10.0..=31.5).contains(&fps), "fps {fps}\n{s}");
     // `]` raises the tick on screen.
     app.send("]");
     app.wait_for("tick 41", 3.0, |s| {
