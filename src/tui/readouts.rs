@@ -112,10 +112,7 @@ impl Readouts<'_> {
                 self.palette.alert(),
             )));
         } else if let Some(n) = &s.notice {
-            lines.push(Line::from(Span::styled(
-                format!(" {n} "),
-                self.palette.alert(),
-            )));
+            lines.push(Line::from(Span::styled(n.clone(), self.palette.alert())));
         } else {
             lines.push(Line::from(""));
         }

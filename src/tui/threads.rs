@@ -20,7 +20,11 @@ pub fn sparkline(values: &[f64], width: usize) -> String {
     let start = values.len().saturating_sub(width);
     let mut s: String = values[start..]
         .iter()
-        .map(|v| BARS[((v / 100.0).clamp(0.0, 1.0) * 8.0).round() as usize])
+        .map(|v| {
+            // Any load at all shows as at least the lowest bar.
+            let level = ((v / 100.0).clamp(0.0, 1.0) * 8.0).round() as usize;
+            BARS[if *v > 0.0 { level.max(1) } else { level }]
+        })
         .collect();
     // Right-aligned so the newest sample is always in the same column.
     let pad = width.saturating_sub(values.len() - start);
