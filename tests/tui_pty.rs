@@ -337,3 +337,16 @@ fn a_panic_in_another_thread_restores_the_terminal_then_prints_and_fails() {
             .contains("test panic in a worker thread")
     );
 }
+
+#[test]
+fn ctrl_c_and_esc_quit_cleanly() {
+    for key in ["\x03", "\x1b"] {
+        let mut app = start(&[], None);
+        app.wait_for("the readouts", 10.0, |s| s.contains("threading"));
+        app.send(key);
+        let st = app.wait_exit(3.0).expect("the key ends the app");
+        assert!(st.success(), "{key:?}: {st:?}");
+        thread::sleep(Duration::from_millis(200));
+        assert!(!app.screen.lock().unwrap().screen().alternate_screen());
+    }
+}

@@ -49,9 +49,10 @@ impl Guard {
         });
         terminal::enable_raw_mode()?;
         ACTIVE.store(true, Ordering::SeqCst);
-        let mut out = io::stdout();
-        execute!(out, terminal::EnterAlternateScreen, cursor::Hide)?;
-        Ok(Guard(()))
+        // Made before the next step, so a failure there is undone too.
+        let guard = Guard(());
+        execute!(io::stdout(), terminal::EnterAlternateScreen, cursor::Hide)?;
+        Ok(guard)
     }
 }
 
