@@ -3,6 +3,7 @@ use ballpit::cli::{Cli, Command};
 use ballpit::error::BadInput;
 use ballpit::{bench, scene};
 use clap::Parser;
+use std::io::Write;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -11,10 +12,11 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             if let Some(bad) = e.downcast_ref::<BadInput>() {
-                eprintln!("ballpit: {bad}");
+                // stderr may be gone with the terminal: never panic for it.
+                let _ = writeln!(std::io::stderr(), "ballpit: {bad}");
                 ExitCode::from(2)
             } else {
-                eprintln!("ballpit: {e:#}");
+                let _ = writeln!(std::io::stderr(), "ballpit: {e:#}");
                 ExitCode::FAILURE
             }
         }
