@@ -5,15 +5,24 @@
 //!
 //! `cargo bench --bench engine` (criterion; a phase breakdown is printed
 //! first).
+use ballpit::cpu::CpuReport;
 use ballpit::engine::{Engine, Settings, Snapshot, Threading};
 use ballpit::physics::broad::Grid;
 use ballpit::physics::contact::pair_toi;
 use ballpit::physics::{Exec, ModelKind, Serial, Sphere, World};
+use ballpit::tui::app::{self, View};
+use ballpit::tui::canvas::Raster;
+use ballpit::tui::output::{Counting, Lean};
+use ballpit::tui::readouts::Stats;
+use ballpit::tui::state::AppState;
+use ballpit::tui::theme::Palette;
 use criterion::{Criterion, SamplingMode};
 use glam::DVec3;
 use parking_lot::Mutex;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
+use ratatui::layout::Rect;
+use ratatui::{Terminal, TerminalOptions, Viewport};
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
@@ -408,6 +417,115 @@ fn engines(
         .collect()
 }
 
+/// The TUI's own drawing of a frame (projection, raster, ratatui diff,
+/// terminal bytes into a sink) at 200x60, as `benches/frame.rs` does it.
+struct TuiDraw {
+    term: Terminal<Lean<Counting<std::io::Sink>>>,
+    raster: Raster,
+    state: AppState,
+}
+
+impl TuiDraw {
+    fn new(world: &World) -> TuiDraw {
+        let (writer, _) = Counting::new(std::io::sink());
+        let term = Terminal::with_options(
+            Lean::new(writer),
+            TerminalOptions {
+                viewport: Viewport::Fixed(Rect::new(0, 0, 200, 60)),
+            },
+        )
+        .unwrap();
+        let r = world.spheres[0].radius;
+        let state = AppState::new(
+            &settings(Threading::Off, 1, 1),
+            world.spheres.len(),
+            r,
+            30.0,
+        );
+        TuiDraw {
+            term,
+            raster: Raster::new(),
+            state,
+        }
+    }
+
+    fn draw(&mut self, snap: &Snapshot) {
+        let (stats, report) = (Stats::default(), CpuReport::default());
+        let view = View {
+            state: &self.state,
+            snap,
+            stats: &stats,
+            report: &report,
+            palette: Palette::C16,
+            aspect: 2.0,
+        };
+        let raster = &mut self.raster;
+        self.term.draw(|f| app::draw(f, raster, &view)).unwrap();
+    }
+}
+
+/// `off` against `worker` with the TUI's drawing, the physics tick chosen so
+/// a frame's physics costs about what its drawing costs.
+fn tui_pipelining(c: &mut Criterion) {
+    let world = scene(10_000, 0.006, 0.5, 3);
+    let mut draw = TuiDraw::new(&world);
+    let mut e = Engine::new(world.clone(), settings(Threading::Off, 1, 1)).unwrap();
+    let t0 = cpu_now();
+    for _ in 0..20 {
+        e.start_frame().unwrap();
+    }
+    let step = (cpu_now() - t0) / 20.0;
+    let t0 = cpu_now();
+    for _ in 0..20 {
+        draw.draw(e.snapshot());
+    }
+    let drawing = (cpu_now() - t0) / 20.0;
+    let tick = (drawing / step).round().max(1.0) as u32;
+    eprintln!(
+        "tui pipelining: drawing {:.2} ms/frame, physics {:.2} ms per frame of 1 step: tick {tick}",
+        drawing * 1e3,
+        step * 1e3
+    );
+    let mut engines = engines(
+        &world,
+        &[("off", Threading::Off, 1), ("worker", Threading::Worker, 1)],
+        tick,
+    );
+    let mut times = [Vec::new(), Vec::new()];
+    for round in 0..15 {
+        for k in 0..2 {
+            let i = (round + k) % 2;
+            let t0 = Instant::now();
+            for _ in 0..10 {
+                let e = &mut engines[i].1;
+                e.start_frame().unwrap();
+                draw.draw(e.snapshot());
+                e.finish_frame().unwrap();
+            }
+            times[i].push(t0.elapsed().as_secs_f64());
+        }
+    }
+    let mut r: Vec<f64> = times[0].iter().zip(&times[1]).map(|(a, b)| a / b).collect();
+    r.sort_by(f64::total_cmp);
+    eprintln!(
+        "paired TUI drawing + swept N=10000 tick {tick}: worker over off: median {:.2}x \
+         (min {:.2}, max {:.2}; 15 rounds of 10 frames)",
+        r[7], r[0], r[14]
+    );
+    let mut g = c.benchmark_group("tui_frame_10k");
+    g.sample_size(20).measurement_time(Duration::from_secs(6));
+    for (name, e) in &mut engines {
+        g.bench_function(*name, |b| {
+            b.iter(|| {
+                e.start_frame().unwrap();
+                draw.draw(e.snapshot());
+                e.finish_frame().unwrap();
+            })
+        });
+    }
+    g.finish();
+}
+
 fn main() {
     let mut c = Criterion::default().configure_from_args();
     let fast = scene(100_000, 0.004, 0.5, 1);
@@ -438,6 +556,7 @@ fn main() {
     );
     bench_pool(&mut c, "v0.5", &fast);
     bench_pool(&mut c, "v0.1", &slow);
+    tui_pipelining(&mut c);
     bench_pipelining(&mut c, &small, passes);
     c.final_summary();
 }
