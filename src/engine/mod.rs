@@ -4,6 +4,15 @@
 //! API contract (the TUI and `bench` depend on it; extend, don't break):
 //! `Engine::new`, `command`, `start_frame`, `finish_frame`, `snapshot`,
 //! `settings`, `world`.
+//!
+//! Threads: `physics` (created with the engine, asleep on a channel until a
+//! frame is handed to it) drives every threaded mode; `pool` lends it
+//! `pool-0..K-1` for the data-parallel sections, `split` lends it
+//! `split-pair` and `split-wall` for the two functional jobs. The physics
+//! cuts its work into fixed blocks combined in block order, so every mode
+//! gives the same bits. The frame (world, model, executor, back snapshot)
+//! moves whole to the thread that runs it and back, so no lock guards the
+//! world and a mode switch between frames cannot lose or repeat anything.
 mod frame;
 mod pool;
 mod snapshot;
