@@ -415,6 +415,34 @@ fn count_edits_go_into_free_space() {
 }
 
 #[test]
+fn an_emptied_scene_refills_like_the_start() {
+    let world = scene(100, 0.03, 0.0, 0, 0.4, 12);
+    let rms = ballpit::physics::edit::rms_speed(&world);
+    // Tick 0: the frames apply the edits and step nothing.
+    let mut e = Engine::new(world, settings(ModelKind::Discrete, Threading::Pool, 2, 0)).unwrap();
+    e.command(Command::SetCount(0));
+    e.start_frame().unwrap();
+    let snap = e.finish_frame().unwrap().clone();
+    assert_eq!(
+        (snap.spheres.len(), snap.energy, snap.energy_drift()),
+        (0, 0.0, 0.0)
+    );
+    e.command(Command::SetRadius(0.05));
+    e.command(Command::SetCount(40));
+    e.start_frame().unwrap();
+    e.finish_frame().unwrap();
+    let w = e.world();
+    assert_eq!(w.spheres.len(), 40);
+    assert!(w.spheres.iter().all(|s| s.radius == 0.03));
+    assert!(
+        w.spheres
+            .iter()
+            .all(|s| (s.vel.length() - rms).abs() < 1e-12)
+    );
+    assert_eq!((w.escaped(), w.max_overlap_rel()), (0, 0.0));
+}
+
+#[test]
 fn radius_grows_until_spheres_touch() {
     let world = scene(300, 0.02, 0.0, 0, 0.5, 10);
     let mut e = Engine::new(world, settings(ModelKind::Swept, Threading::Off, 1, 0)).unwrap();
