@@ -3,6 +3,7 @@ use ballpit::cli::{Cli, Command};
 use ballpit::error::BadInput;
 use ballpit::{bench, scene};
 use clap::Parser;
+use std::io::Write;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -11,10 +12,11 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             if let Some(bad) = e.downcast_ref::<BadInput>() {
-                eprintln!("ballpit: {bad}");
+                // stderr may be gone with the terminal: never panic for it.
+                let _ = writeln!(std::io::stderr(), "ballpit: {bad}");
                 ExitCode::from(2)
             } else {
-                eprintln!("ballpit: {e:#}");
+                let _ = writeln!(std::io::stderr(), "ballpit: {e:#}");
                 ExitCode::FAILURE
             }
         }
@@ -39,13 +41,15 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         None => {
             let settings = cli.run.settings()?;
             let world = scene::build_world(&cli.scene.spec())?;
-            println!(
-                "ballpit: {} spheres, model {}, threading {}. The terminal app is not built yet; try `ballpit bench --steps 600`.",
-                world.spheres.len(),
-                settings.model,
-                settings.threading
-            );
-            Ok(())
+            let color = match cli.color.as_deref() {
+                None => ballpit::tui::ColorChoice::Auto,
+                Some(c) => c.parse().map_err(BadInput)?,
+            };
+            let opts = ballpit::tui::Options {
+                fps: cli.fps,
+                color,
+            };
+            ballpit::tui::run(world, settings, opts)
         }
     }
 }
