@@ -86,8 +86,20 @@ pub struct Exact {
     valid: bool,
     cap: Option<u64>,
     observer: Option<Observer>,
-    /// Events processed since construction (all kinds, stale included).
-    pub events_processed: u64,
+    /// Events processed since construction, by kind.
+    pub stats: EventStats,
+}
+
+/// Events the loop has processed, by kind (for tuning and the benchmarks).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct EventStats {
+    pub pairs: u64,
+    /// Contact predictions found stale (the partner moved on) when due.
+    pub stale: u64,
+    pub walls: u64,
+    pub relists: u64,
+    /// Full rebuilds of the schedule (start, outside changes, capped steps).
+    pub rebuilds: u64,
 }
 
 impl Exact {
@@ -139,6 +151,7 @@ impl Exact {
     /// New neighbour lists and a prediction for every sphere, at the bodies'
     /// common time stamp.
     fn reschedule_all(&mut self) {
+        self.stats.rebuilds += 1;
         let n = self.bodies.len();
         self.counts.clear();
         self.counts.resize(n, 0);
@@ -204,22 +217,24 @@ impl Exact {
                 return false;
             }
             done += 1;
-            self.events_processed += 1;
             let ev = self.events[i];
             self.bodies[i].advance(t);
             match ev.kind {
                 Kind::Pair => {
                     let j = ev.partner as usize;
                     if self.counts[j] != ev.partner_count {
+                        self.stats.stale += 1;
                         self.schedule(i);
                         continue;
                     }
+                    self.stats.pairs += 1;
                     self.bodies[j].advance(t);
                     self.collide(i, j, c);
                     self.schedule(i);
                     self.schedule(j);
                 }
                 Kind::Wall => {
+                    self.stats.walls += 1;
                     let b = &mut self.bodies[i];
                     let mut s = b.sphere(self.mass[i]);
                     let mask = [ev.mask & 1 != 0, ev.mask & 2 != 0, ev.mask & 4 != 0];
@@ -238,6 +253,7 @@ impl Exact {
                     self.schedule(i);
                 }
                 Kind::Relist => {
+                    self.stats.relists += 1;
                     self.neighbours.rebuild(i, &self.bodies);
                     self.schedule(i);
                 }
@@ -302,8 +318,6 @@ impl Model for Exact {
         }
         if !self.matches(world) {
             self.load(world);
-        } else {
-            self.reorigin(world.time);
         }
         for _ in 0..steps {
             let end = world.time + dt;

@@ -28,11 +28,110 @@ const TARGET_NEIGHBOURS: f64 = 12.0;
 /// positions can never let a non-neighbour slip into contact.
 const TRIGGER: f64 = 1.0 - 1e-6;
 
+/// A list centre with the sphere's radius beside it: the scan reads one line.
+#[derive(Clone, Copy, Debug, Default)]
+struct Centre {
+    pos: DVec3,
+    radius: f64,
+}
+
+/// Neighbour lists of the bulk spheres in one flat array with a fixed
+/// stride (no pointer per list; the stride doubles if a list ever fills),
+/// and separate growable lists for the few large spheres, whose neighbours
+/// may number thousands.
+#[derive(Clone, Debug, Default)]
+struct Lists {
+    stride: usize,
+    flat: Vec<u32>,
+    len: Vec<u32>,
+    /// Index into `big` for second-level spheres, else `NONE`.
+    slot: Vec<u32>,
+    big: Vec<Vec<u32>>,
+}
+
+impl Lists {
+    fn reset(&mut self, n: usize) {
+        self.stride = 32;
+        self.flat.clear();
+        self.flat.resize(n * self.stride, 0);
+        self.len.clear();
+        self.len.resize(n, 0);
+        self.slot.clear();
+        self.slot.resize(n, NONE);
+        self.big.clear();
+    }
+
+    fn make_big(&mut self, i: usize) {
+        self.slot[i] = self.big.len() as u32;
+        self.big.push(Vec::new());
+    }
+
+    #[inline]
+    fn of(&self, i: usize) -> &[u32] {
+        match self.slot[i] {
+            NONE => &self.flat[i * self.stride..i * self.stride + self.len[i] as usize],
+            s => &self.big[s as usize],
+        }
+    }
+
+    #[inline]
+    fn push(&mut self, i: usize, j: u32) {
+        match self.slot[i] {
+            NONE => {
+                if self.len[i] as usize == self.stride {
+                    self.grow();
+                }
+                self.flat[i * self.stride + self.len[i] as usize] = j;
+                self.len[i] += 1;
+            }
+            s => self.big[s as usize].push(j),
+        }
+    }
+
+    #[inline]
+    fn remove(&mut self, i: usize, j: u32) {
+        match self.slot[i] {
+            NONE => {
+                let start = i * self.stride;
+                let l = &mut self.flat[start..start + self.len[i] as usize];
+                if let Some(k) = l.iter().position(|&x| x == j) {
+                    l[k] = l[l.len() - 1];
+                    self.len[i] -= 1;
+                }
+            }
+            s => {
+                let l = &mut self.big[s as usize];
+                if let Some(k) = l.iter().position(|&x| x == j) {
+                    l.swap_remove(k);
+                }
+            }
+        }
+    }
+
+    fn clear(&mut self, i: usize) {
+        match self.slot[i] {
+            NONE => self.len[i] = 0,
+            s => self.big[s as usize].clear(),
+        }
+    }
+
+    fn grow(&mut self) {
+        let old = self.stride;
+        self.stride *= 2;
+        let mut flat = vec![0; self.len.len() * self.stride];
+        for (i, &l) in self.len.iter().enumerate() {
+            let l = l as usize;
+            flat[i * self.stride..i * self.stride + l].copy_from_slice(&self.flat[i * old..i * old + l]);
+        }
+        self.flat = flat;
+    }
+}
+
 #[derive(Clone, Debug, Default)]
 pub struct Neighbours {
     skin: f64,
-    centre: Vec<DVec3>,
-    lists: Vec<Vec<u32>>,
+    centre: Vec<Centre>,
+    lists: Lists,
     per_side: usize,
     inv_cell: f64,
     /// Intrusive doubly linked list of the spheres in each cell, by centre.
@@ -50,9 +149,11 @@ impl Neighbours {
     pub fn build(&mut self, bodies: &[Body], size: f64) {
         let n = bodies.len();
         self.centre.clear();
-        self.centre.extend(bodies.iter().map(|b| b.pos));
-        self.lists.resize_with(n, Vec::new);
-        self.lists.iter_mut().for_each(Vec::clear);
+        self.centre.extend(bodies.iter().map(|b| Centre {
+            pos: b.pos,
+            radius: b.radius,
+        }));
+        self.lists.reset(n);
         self.bigs.clear();
         self.next.clear();
         self.next.resize(n, NONE);
@@ -92,6 +193,7 @@ impl Neighbours {
         for (i, b) in bodies.iter().enumerate() {
             if b.radius > big_above {
                 self.bigs.push(i as u32);
+                self.lists.make_big(i);
             } else {
                 self.insert(i, self.cell_index(b.pos));
             }
@@ -103,16 +205,12 @@ impl Neighbours {
 
     /// Sphere `i` (moved to the current time) gets a new centre and list.
     pub fn rebuild(&mut self, i: usize, bodies: &[Body]) {
-        let mut old = std::mem::take(&mut self.lists[i]);
-        for &j in &old {
-            let l = &mut self.lists[j as usize];
-            if let Some(k) = l.iter().position(|&x| x as usize == i) {
-                l.swap_remove(k);
-            }
+        for k in 0..self.lists.of(i).len() {
+            let j = self.lists.of(i)[k];
+            self.lists.remove(j as usize, i as u32);
         }
-        old.clear();
-        self.lists[i] = old;
-        self.centre[i] = bodies[i].pos;
+        self.lists.clear(i);
+        self.centre[i].pos = bodies[i].pos;
         if self.cell[i] != NONE {
             self.remove(i);
             self.insert(i, self.cell_index(bodies[i].pos));
@@ -122,13 +220,13 @@ impl Neighbours {
 
     #[inline]
     pub fn of(&self, i: usize) -> &[u32] {
-        &self.lists[i]
+        self.lists.of(i)
     }
 
     /// Time from `b.t` until sphere `i` has wandered to the edge of its skin.
     #[inline]
     pub fn relist_time(&self, i: usize, b: &Body) -> f64 {
-        let d = b.pos - self.centre[i];
+        let d = b.pos - self.centre[i].pos;
         let a = b.vel.length_squared();
         if a == 0.0 {
             return f64::INFINITY;
@@ -147,17 +245,17 @@ impl Neighbours {
 
     /// Find the neighbours `j` of `i` (with `want(j)`) and link both ways.
     fn scan(&mut self, i: usize, bodies: &[Body], want: impl Fn(usize) -> bool) {
-        let ci = self.centre[i];
+        let ci = self.centre[i].pos;
         let ri = bodies[i].radius + 2.0 * self.skin;
-        let mut found = std::mem::take(&mut self.lists[i]);
-        let mut test = |j: usize, centre: &[DVec3], lists: &mut [Vec<u32>]| {
+        let test = |j: usize, centre: &[Centre], lists: &mut Lists| {
             if !want(j) {
                 return;
             }
-            let s = ri + bodies[j].radius;
-            if (ci - centre[j]).length_squared() < s * s {
-                found.push(j as u32);
-                lists[j].push(i as u32);
+            let c = &centre[j];
+            let s = ri + c.radius;
+            if (ci - c.pos).length_squared() < s * s {
+                lists.push(i, j as u32);
+                lists.push(j, i as u32);
             }
         };
         let reach = if self.cell[i] == NONE {
@@ -187,7 +285,6 @@ impl Neighbours {
         for k in 0..self.bigs.len() {
             test(self.bigs[k] as usize, &self.centre, &mut self.lists);
         }
-        self.lists[i] = found;
     }
 
     fn coords(&self, p: DVec3) -> [usize; 3] {
