@@ -18,3 +18,9 @@ impl std::error::Error for BadInput {}
 macro_rules! bad {
     ($($t:tt)*) => { Err($crate::error::BadInput(format!($($t)*))) };
 }
+
+/// Shorthand for `BadInput(format!(...))`, for `map_err`.
+#[macro_export]
+macro_rules! bad_input {
+    ($($t:tt)*) => { $crate::error::BadInput(format!($($t)*)) };
+}

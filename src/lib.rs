@@ -1,7 +1,10 @@
 //! ballpit: elastic spheres in a cube, on worker threads, drawn in a terminal.
 #![forbid(unsafe_code)]
 
+pub mod bench;
+pub mod cli;
 pub mod cpu;
 pub mod engine;
 pub mod error;
 pub mod physics;
+pub mod scene;

@@ -1,2 +1,51 @@
 #![forbid(unsafe_code)]
-fn main() {}
+use ballpit::cli::{Cli, Command};
+use ballpit::error::BadInput;
+use ballpit::{bench, scene};
+use clap::Parser;
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            if let Some(bad) = e.downcast_ref::<BadInput>() {
+                eprintln!("ballpit: {bad}");
+                ExitCode::from(2)
+            } else {
+                eprintln!("ballpit: {e:#}");
+                ExitCode::FAILURE
+            }
+        }
+    }
+}
+
+fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Some(Command::Bench(args)) => {
+            let settings = args.run.settings()?;
+            let world = scene::build_world(&args.scene.spec())?;
+            let (report, world) = bench::run(world, &settings, args.steps)?;
+            if let Some(path) = &args.dump {
+                scene::csv_io::dump(&world, path)?;
+            }
+            println!("{}", serde_json::to_string(&report)?);
+            Ok(())
+        }
+        Some(Command::Tradeoff(_)) => {
+            Err(BadInput("`ballpit tradeoff` is not built yet".into()).into())
+        }
+        None => {
+            let settings = cli.run.settings()?;
+            let world = scene::build_world(&cli.scene.spec())?;
+            println!(
+                "ballpit: {} spheres, model {}, threading {}. The terminal app is not built yet; try `ballpit bench --steps 600`.",
+                world.spheres.len(),
+                settings.model,
+                settings.threading
+            );
+            Ok(())
+        }
+    }
+}

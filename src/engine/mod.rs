@@ -59,7 +59,9 @@ impl FromStr for Threading {
             .iter()
             .copied()
             .find(|t| t.name() == s)
-            .ok_or_else(|| format!("unknown threading '{s}' (expected one of: off, worker, pool, split)"))
+            .ok_or_else(|| {
+                format!("unknown threading '{s}' (expected one of: off, worker, pool, split)")
+            })
     }
 }
 

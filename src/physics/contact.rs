@@ -60,9 +60,9 @@ pub fn wall_toi(s: &Sphere, size: f64) -> (f64, [bool; 3]) {
 pub fn reflect_walls(s: &mut Sphere, mask: [bool; 3]) -> (f64, u64) {
     let mut impulse = 0.0;
     let mut hits = 0;
-    for k in 0..3 {
+    for (k, &hit) in mask.iter().enumerate() {
         let v = s.vel[k];
-        if mask[k] && v != 0.0 {
+        if hit && v != 0.0 {
             s.vel[k] = -v;
             impulse += 2.0 * s.mass * v.abs();
             hits += 1;

@@ -62,7 +62,7 @@ impl Discrete {
             world.counters.wall_momentum += imp;
             world.counters.wall_collisions += hits;
         }
-        self.grid.build(&world.spheres, size, |s| s.radius);
+        self.grid.build(&world.spheres, size, |s| (s.pos, s.radius));
         let sp = &world.spheres;
         let overlapping = |i: u32, j: u32| {
             let (a, b) = (&sp[i as usize], &sp[j as usize]);

@@ -28,7 +28,11 @@ pub fn fly(s: &mut Sphere, size: f64, t: f64) -> (f64, u64) {
         let segs = (u1 / w).floor();
         let f = (u1 - segs * w).clamp(0.0, w);
         let odd = segs % 2.0 != 0.0;
-        let (xm, vm) = if odd { (lo + w - f, -speed) } else { (lo + f, speed) };
+        let (xm, vm) = if odd {
+            (lo + w - f, -speed)
+        } else {
+            (lo + f, speed)
+        };
         let (xn, vn) = if v > 0.0 { (xm, vm) } else { (size - xm, -vm) };
         s.pos[k] = xn;
         s.vel[k] = vn;

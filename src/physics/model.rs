@@ -52,7 +52,10 @@ impl FromStr for ModelKind {
             .find(|m| m.name() == s)
             .ok_or_else(|| {
                 let names: Vec<_> = Self::ALL.iter().map(|m| m.name()).collect();
-                format!("unknown model '{s}' (expected one of: {})", names.join(", "))
+                format!(
+                    "unknown model '{s}' (expected one of: {})",
+                    names.join(", ")
+                )
             })
     }
 }

@@ -1,39 +1,47 @@
-//! `swept`: the article's model done right. Within a step, the pairs that can
-//! meet (their reach spheres overlap at the start of the step) are found once;
-//! their contacts are then processed in time order, each sphere advanced only
-//! when touched, until the step is used up. Spheres with no partner in reach
-//! fly in closed form. A contact with a sphere that was out of reach at the
-//! start of the step (a chain the step did not foresee) is missed: that is
-//! the model's trade against `exact`.
+//! `swept`: the article's model done right. Each step finds the contacts it
+//! can foresee — pairs that meet on straight paths within the step, spheres
+//! that reach a wall — and processes them in time order, each sphere moved
+//! only when touched (lazy update). Whenever a contact changes a velocity,
+//! that sphere looks again for partners within its reach, so chains of
+//! contacts inside a step are followed, not missed. The rest fly straight.
+//! A pathological step (near jamming) is cut off by an event cap, finished
+//! in free flight and counted in `capped_steps`.
 use super::broad::{Grid, Pair};
 use super::contact::{pair_toi, reflect_walls, resolve_pair, wall_toi};
 use super::exec::{Exec, for_each_block};
 use super::flight::fly;
 use super::model::{Model, ModelKind};
 use super::sphere::Sphere;
-use super::world::{Counters, World};
+use super::world::World;
+use glam::DVec3;
 use parking_lot::Mutex;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
-/// Spheres per parallel block for flight; fixed so sums never depend on the
-/// number of threads.
+/// Spheres per parallel block; fixed so results never depend on the number
+/// of threads.
 pub(crate) const SPHERE_BLOCK: usize = 2048;
 const NONE: u32 = u32::MAX;
+/// Reach balls are widened by this much so touching spheres, whose distance
+/// rounds either way, are always seen.
+const REACH_SLACK: f64 = 1.0 + 1e-9;
 
 #[derive(Default)]
 pub struct Swept {
     grid: Grid,
     pairs: Vec<Pair>,
+    wall_slots: Vec<Mutex<Vec<u32>>>,
+    /// Sphere index → local index among the spheres with events, or NONE.
     local: Vec<u32>,
     involved: Vec<u32>,
     t_local: Vec<f64>,
     count: Vec<u32>,
-    adj_start: Vec<u32>,
-    adj: Vec<u32>,
+    /// Each sphere's ball for the step: it stays within `reach` of `centre`.
+    centre: Vec<DVec3>,
+    reach: Vec<f64>,
+    grown: Vec<u32>,
     heap: BinaryHeap<Event>,
-    flown: Vec<(Sphere, f64, u64)>,
-    block_walls: Vec<Mutex<(f64, u64)>>,
+    found: Vec<u32>,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -57,13 +65,25 @@ impl PartialOrd for Event {
     }
 }
 impl Ord for Event {
-    /// Reversed: the heap pops the earliest; ties in a fixed order (lower
-    /// sphere first, wall events after pair events of the same sphere).
+    /// Reversed so the heap pops the earliest; simultaneous events in a fixed
+    /// order: lower local index first, pair events before wall events.
     fn cmp(&self, o: &Self) -> Ordering {
         o.t.total_cmp(&self.t)
             .then(o.a.cmp(&self.a))
             .then(o.b.cmp(&self.b))
     }
+}
+
+/// The ball a sphere on a straight path stays in during the step: centred
+/// on the middle of its path, half the path plus its radius wide (an eighth
+/// of the volume of the ball around the start point).
+#[inline]
+fn path_ball(s: &Sphere, dt: f64) -> (DVec3, f64) {
+    let half = 0.5 * dt;
+    (
+        s.pos + s.vel * half,
+        (s.radius + s.vel.length() * half) * REACH_SLACK,
+    )
 }
 
 impl Model for Swept {
@@ -83,135 +103,116 @@ impl Swept {
     fn step(&mut self, world: &mut World, dt: f64, exec: &dyn Exec) {
         let size = world.size;
         let n = world.spheres.len();
-        self.grid
-            .build(&world.spheres, size, |s| s.radius + s.vel.length() * dt);
+        self.grid.build(&world.spheres, size, |s| path_ball(s, dt));
         let blocks = n.div_ceil(SPHERE_BLOCK);
-        while self.block_walls.len() < blocks {
-            self.block_walls.push(Mutex::new((0.0, 0)));
+        while self.wall_slots.len() < blocks {
+            self.wall_slots.push(Mutex::new(Vec::new()));
         }
+        let sp = &world.spheres;
+        let meets = |i: u32, j: u32| {
+            let (a, b) = (&sp[i as usize], &sp[j as usize]);
+            pair_toi(a.pos - b.pos, a.vel - b.vel, a.radius + b.radius).is_some_and(|t| t <= dt)
+        };
+        let slots = &self.wall_slots;
+        let walls = |exec: &dyn Exec| {
+            for_each_block(exec, blocks, &|b| {
+                let mut v = slots[b].lock();
+                v.clear();
+                let end = ((b + 1) * SPHERE_BLOCK).min(n);
+                v.extend(
+                    (b * SPHERE_BLOCK..end)
+                        .filter(|&i| reaches_wall(&sp[i], size, dt))
+                        .map(|i| i as u32),
+                );
+            })
+        };
         if exec.functional() {
-            // Functional decomposition: sphere–sphere work (which pairs can
-            // meet) beside sphere–wall work (every sphere's flight, kept for
-            // the ones that turn out to have no partner).
+            // Functional decomposition: sphere–sphere beside sphere–wall.
             let serial = super::exec::Serial;
             let detect = Mutex::new((&mut self.grid, &mut self.pairs));
-            let flown = Mutex::new(&mut self.flown);
-            let spheres = &world.spheres;
             exec.join(
                 &|| {
                     let mut g = detect.lock();
                     let (grid, pairs) = &mut *g;
-                    grid.pairs(&serial, &|_, _| true, pairs);
+                    grid.pairs(&serial, &meets, pairs);
                 },
-                &|| {
-                    let mut out = flown.lock();
-                    out.clear();
-                    out.extend(spheres.iter().map(|s| {
-                        let mut s = *s;
-                        let (imp, hits) = fly(&mut s, size, dt);
-                        (s, imp, hits)
-                    }));
-                },
+                &|| walls(&serial),
             );
-            self.mark_involved(n);
-            // Same sums in the same order as the block path below.
-            let mut total = (0.0, 0u64);
-            for (b, chunk) in self.flown.chunks(SPHERE_BLOCK).enumerate() {
-                let mut tally = (0.0, 0u64);
-                for (k, (s, imp, hits)) in chunk.iter().enumerate() {
-                    let i = b * SPHERE_BLOCK + k;
-                    if self.local[i] == NONE {
-                        world.spheres[i] = *s;
-                        tally.0 += imp;
-                        tally.1 += hits;
-                    }
-                }
-                total.0 += tally.0;
-                total.1 += tally.1;
-            }
-            add_walls(&mut world.counters, total);
         } else {
-            self.grid.pairs(exec, &|_, _| true, &mut self.pairs);
-            self.mark_involved(n);
-            fly_blocks(
-                &mut world.spheres,
-                Some(&self.local),
-                size,
-                dt,
-                &self.block_walls,
-                exec,
-            );
-            add_walls(&mut world.counters, sum_walls(&self.block_walls[..blocks]));
+            self.grid.pairs(exec, &meets, &mut self.pairs);
+            walls(exec);
         }
-        self.events(world, dt);
+        self.events(world, dt, blocks);
+        // Everyone without an event flies straight and meets no wall.
+        let local = &self.local;
+        let chunks: Vec<Mutex<&mut [Sphere]>> = world
+            .spheres
+            .chunks_mut(SPHERE_BLOCK)
+            .map(Mutex::new)
+            .collect();
+        for_each_block(exec, blocks, &|b| {
+            for (k, s) in chunks[b].lock().iter_mut().enumerate() {
+                if local[b * SPHERE_BLOCK + k] == NONE {
+                    s.pos += s.vel * dt;
+                }
+            }
+        });
     }
 
-    /// Give every sphere in a candidate pair a local index, in pair order.
-    fn mark_involved(&mut self, n: usize) {
+    fn involve(&mut self, sp: &[Sphere], i: u32, dt: f64, size: f64) -> u32 {
+        let l = self.local[i as usize];
+        if l != NONE {
+            return l;
+        }
+        let l = self.involved.len() as u32;
+        let s = &sp[i as usize];
+        self.local[i as usize] = l;
+        self.involved.push(i);
+        self.t_local.push(0.0);
+        self.count.push(0);
+        let (centre, reach) = path_ball(s, dt);
+        self.centre.push(centre);
+        self.reach.push(reach);
+        push_wall(&mut self.heap, s, l, 0.0, 0, size, dt);
+        l
+    }
+
+    /// Contacts in time order within `[0, dt]`; leaves every sphere with an
+    /// event at `dt`, and `local` marking them.
+    fn events(&mut self, world: &mut World, dt: f64, blocks: usize) {
         for &i in &self.involved {
             self.local[i as usize] = NONE;
         }
+        let n = world.spheres.len();
         self.local.resize(n, NONE);
         self.involved.clear();
-        for &(i, j) in &self.pairs {
-            for k in [i, j] {
-                if self.local[k as usize] == NONE {
-                    self.local[k as usize] = self.involved.len() as u32;
-                    self.involved.push(k);
-                }
-            }
-        }
-        let m = self.involved.len();
-        self.adj_start.clear();
-        self.adj_start.resize(m + 1, 0);
-        for &(i, j) in &self.pairs {
-            self.adj_start[self.local[i as usize] as usize + 1] += 1;
-            self.adj_start[self.local[j as usize] as usize + 1] += 1;
-        }
-        for k in 0..m {
-            self.adj_start[k + 1] += self.adj_start[k];
-        }
-        self.adj.clear();
-        self.adj.resize(self.adj_start[m] as usize, 0);
-        let mut fill = self.adj_start[..m].to_vec();
-        for &(i, j) in &self.pairs {
-            let (a, b) = (self.local[i as usize], self.local[j as usize]);
-            self.adj[fill[a as usize] as usize] = b;
-            fill[a as usize] += 1;
-            self.adj[fill[b as usize] as usize] = a;
-            fill[b as usize] += 1;
-        }
-    }
-
-    /// Contacts among the involved spheres, in time order, within `[0, dt]`.
-    fn events(&mut self, world: &mut World, dt: f64) {
-        let m = self.involved.len();
-        if m == 0 {
-            return;
-        }
-        let size = world.size;
         self.t_local.clear();
-        self.t_local.resize(m, 0.0);
         self.count.clear();
-        self.count.resize(m, 0);
+        self.centre.clear();
+        self.reach.clear();
+        self.grown.clear();
         self.heap.clear();
+        let size = world.size;
+        let pairs = std::mem::take(&mut self.pairs);
         let sp = &mut world.spheres;
-        for &(i, j) in &self.pairs {
-            let (a, b) = (self.local[i as usize], self.local[j as usize]);
+        for &(i, j) in &pairs {
+            let a = self.involve(sp, i, dt, size);
+            let b = self.involve(sp, j, dt, size);
             let (si, sj) = (&sp[i as usize], &sp[j as usize]);
-            if let Some(t) = pair_toi(si.pos - sj.pos, si.vel - sj.vel, si.radius + sj.radius)
-                && t <= dt
-            {
-                let (a, b) = (a.min(b), a.max(b));
-                self.heap.push(Event { t, a, b, ca: 0, cb: 0 });
+            if let Some(t) = pair_toi(si.pos - sj.pos, si.vel - sj.vel, si.radius + sj.radius) {
+                self.heap.push(pair_event(t, a, b, 0, 0));
             }
         }
-        for a in 0..m as u32 {
-            push_wall(&mut self.heap, &sp[self.involved[a as usize] as usize], a, 0.0, 0, size, dt);
+        self.pairs = pairs;
+        for b in 0..blocks {
+            let hitters = std::mem::take(&mut *self.wall_slots[b].lock());
+            for &i in &hitters {
+                self.involve(sp, i, dt, size);
+            }
+            *self.wall_slots[b].lock() = hitters;
         }
-        let cap = 10_000 + 64 * m;
+        let cap = 10_000 + 64 * self.involved.len();
         let mut done = 0usize;
-        let c = &mut world.counters;
         while let Some(e) = self.heap.pop() {
             if self.count[e.a as usize] != e.ca || (e.b != NONE && self.count[e.b as usize] != e.cb)
             {
@@ -219,66 +220,136 @@ impl Swept {
             }
             done += 1;
             if done > cap {
-                c.capped_steps += 1;
+                world.counters.capped_steps += 1;
                 break;
             }
             let ia = self.involved[e.a as usize] as usize;
             advance_to(&mut sp[ia], &mut self.t_local[e.a as usize], e.t);
+            self.count[e.a as usize] += 1;
             if e.b == NONE {
                 let (_, mask) = wall_toi(&sp[ia], size);
                 let (imp, hits) = reflect_walls(&mut sp[ia], mask);
-                c.wall_momentum += imp;
-                c.wall_collisions += hits;
-                self.count[e.a as usize] += 1;
-                self.reschedule(sp, e.a, e.t, size, dt);
+                world.counters.wall_momentum += imp;
+                world.counters.wall_collisions += hits;
+                self.rescan(sp, e.a, e.t, size, dt);
             } else {
                 let ib = self.involved[e.b as usize] as usize;
                 advance_to(&mut sp[ib], &mut self.t_local[e.b as usize], e.t);
+                self.count[e.b as usize] += 1;
                 let (x, y) = pair_mut(sp, ia, ib);
                 if resolve_pair(x, y) {
-                    c.sphere_collisions += 1;
+                    world.counters.sphere_collisions += 1;
                 }
-                self.count[e.a as usize] += 1;
-                self.count[e.b as usize] += 1;
-                self.reschedule(sp, e.a, e.t, size, dt);
-                self.reschedule(sp, e.b, e.t, size, dt);
+                self.rescan(sp, e.a, e.t, size, dt);
+                self.rescan(sp, e.b, e.t, size, dt);
             }
         }
-        for a in 0..m {
-            let s = &mut sp[self.involved[a] as usize];
-            let (imp, hits) = fly(s, size, dt - self.t_local[a]);
-            c.wall_momentum += imp;
-            c.wall_collisions += hits;
+        for l in 0..self.involved.len() {
+            let s = &mut sp[self.involved[l] as usize];
+            let (imp, hits) = fly(s, size, dt - self.t_local[l]);
+            world.counters.wall_momentum += imp;
+            world.counters.wall_collisions += hits;
         }
     }
 
-    fn reschedule(&mut self, sp: &[Sphere], a: u32, t: f64, size: f64, dt: f64) {
-        let ids = &self.involved;
-        let sa = &sp[ids[a as usize] as usize];
-        let ca = self.count[a as usize];
-        push_wall(&mut self.heap, sa, a, t, ca, size, dt);
-        let range = self.adj_start[a as usize] as usize..self.adj_start[a as usize + 1] as usize;
-        for &b in &self.adj[range] {
-            let sb = &sp[ids[b as usize] as usize];
-            let pb = sb.pos + sb.vel * (t - self.t_local[b as usize]);
-            if let Some(dtc) = pair_toi(sa.pos - pb, sa.vel - sb.vel, sa.radius + sb.radius)
+    /// Sphere `a` changed velocity at `t`: widen its reach ball if its new
+    /// path needs it, and schedule its next wall and every partner it can
+    /// now meet before the step ends.
+    fn rescan(&mut self, sp: &[Sphere], a: u32, t: f64, size: f64, dt: f64) {
+        let la = a as usize;
+        let ia = self.involved[la] as usize;
+        let sa = sp[ia];
+        let need = ((sa.pos - self.centre[la]).length() + sa.vel.length() * (dt - t) + sa.radius)
+            * REACH_SLACK;
+        // Grid spheres may grow up to `small` and still be found through the
+        // cells; beyond that they join `grown`, which every rescan checks.
+        let small = 2.0 * self.grid.small_reach();
+        if need > self.reach[la] {
+            if need > small && self.reach[la] <= small {
+                self.grown.push(a);
+            }
+            self.reach[la] = need;
+        }
+        let ca = self.count[la];
+        push_wall(&mut self.heap, &sa, a, t, ca, size, dt);
+        let (p0, ra) = (self.centre[la], self.reach[la]);
+        let mut found = std::mem::take(&mut self.found);
+        found.clear();
+        let local = &self.local;
+        let reach = &self.reach;
+        let mut consider = |j: u32, pj0: DVec3, rj: f64| {
+            let rj = match local[j as usize] {
+                NONE => rj,
+                l => reach[l as usize],
+            };
+            if p0.distance_squared(pj0) <= (ra + rj) * (ra + rj) {
+                found.push(j);
+            }
+        };
+        self.grid.near(p0, ra + small, &mut consider);
+        for &g in &self.grown {
+            let lg = g as usize;
+            consider(self.involved[lg], self.centre[lg], self.reach[lg]);
+        }
+        found.sort_unstable();
+        found.dedup();
+        for &j in &found {
+            if j as usize == ia {
+                continue;
+            }
+            let s = &sp[j as usize];
+            let since = match self.local[j as usize] {
+                NONE => t,
+                l => t - self.t_local[l as usize],
+            };
+            let pj = s.pos + s.vel * since;
+            if let Some(dtc) = pair_toi(sa.pos - pj, sa.vel - s.vel, sa.radius + s.radius)
                 && t + dtc <= dt
             {
+                let b = self.involve(sp, j, dt, size);
                 let cb = self.count[b as usize];
-                let (x, y, cx, cy) = if a < b { (a, b, ca, cb) } else { (b, a, cb, ca) };
-                self.heap.push(Event {
-                    t: t + dtc,
-                    a: x,
-                    b: y,
-                    ca: cx,
-                    cb: cy,
-                });
+                self.heap.push(pair_event(t + dtc, a, b, ca, cb));
             }
+        }
+        self.found = found;
+    }
+}
+
+/// Whether the straight path of `s` over `dt` leaves `[r, L - r]^3` (the
+/// box is convex, so the end point tells), touching included.
+#[inline]
+fn reaches_wall(s: &Sphere, size: f64, dt: f64) -> bool {
+    let end = s.pos + s.vel * dt;
+    let (lo, hi) = (s.radius, size - s.radius);
+    end.min_element() <= lo
+        || end.max_element() >= hi
+        || s.pos.min_element() <= lo
+        || s.pos.max_element() >= hi
+}
+
+fn pair_event(t: f64, a: u32, b: u32, ca: u32, cb: u32) -> Event {
+    if a < b {
+        Event { t, a, b, ca, cb }
+    } else {
+        Event {
+            t,
+            a: b,
+            b: a,
+            ca: cb,
+            cb: ca,
         }
     }
 }
 
-fn push_wall(heap: &mut BinaryHeap<Event>, s: &Sphere, a: u32, t: f64, ca: u32, size: f64, dt: f64) {
+fn push_wall(
+    heap: &mut BinaryHeap<Event>,
+    s: &Sphere,
+    a: u32,
+    t: f64,
+    ca: u32,
+    size: f64,
+    dt: f64,
+) {
     let (tw, _) = wall_toi(s, size);
     if t + tw <= dt {
         heap.push(Event {
@@ -305,43 +376,4 @@ pub(crate) fn pair_mut<T>(v: &mut [T], i: usize, j: usize) -> (&mut T, &mut T) {
         let (lo, hi) = v.split_at_mut(i);
         (&mut hi[0], &mut lo[j])
     }
-}
-
-/// Closed-form flight for every sphere (or, with `skip`, every sphere whose
-/// entry is `NONE`), block-parallel, wall tallies per block.
-fn fly_blocks(
-    spheres: &mut [Sphere],
-    skip: Option<&[u32]>,
-    size: f64,
-    dt: f64,
-    walls: &[Mutex<(f64, u64)>],
-    exec: &dyn Exec,
-) {
-    let chunks: Vec<Mutex<&mut [Sphere]>> =
-        spheres.chunks_mut(SPHERE_BLOCK).map(Mutex::new).collect();
-    for_each_block(exec, chunks.len(), &|b| {
-        let mut chunk = chunks[b].lock();
-        let mut tally = (0.0, 0u64);
-        for (k, s) in chunk.iter_mut().enumerate() {
-            if skip.is_some_and(|l| l[b * SPHERE_BLOCK + k] != NONE) {
-                continue;
-            }
-            let (imp, hits) = fly(s, size, dt);
-            tally.0 += imp;
-            tally.1 += hits;
-        }
-        *walls[b].lock() = tally;
-    });
-}
-
-fn sum_walls(walls: &[Mutex<(f64, u64)>]) -> (f64, u64) {
-    walls.iter().fold((0.0, 0), |acc, w| {
-        let w = *w.lock();
-        (acc.0 + w.0, acc.1 + w.1)
-    })
-}
-
-fn add_walls(c: &mut Counters, (imp, hits): (f64, u64)) {
-    c.wall_momentum += imp;
-    c.wall_collisions += hits;
 }

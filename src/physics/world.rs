@@ -56,9 +56,7 @@ impl World {
         self.spheres
             .iter()
             .filter(|s| {
-                (0..3).any(|k| {
-                    s.pos[k] < s.radius - tol || s.pos[k] > self.size - s.radius + tol
-                })
+                (0..3).any(|k| s.pos[k] < s.radius - tol || s.pos[k] > self.size - s.radius + tol)
             })
             .count()
     }

@@ -1,0 +1,89 @@
+//! Sphere CSV: header `x,y,z,vx,vy,vz,radius,mass`, one sphere a row.
+//! Numbers are written in Rust's shortest round-trip form, so a dump reads
+//! back bit for bit.
+use super::place::check;
+use crate::error::BadInput;
+use crate::physics::{Sphere, World};
+use crate::{bad, bad_input};
+use glam::DVec3;
+use std::io::Write;
+use std::path::Path;
+
+pub const HEADER: [&str; 8] = ["x", "y", "z", "vx", "vy", "vz", "radius", "mass"];
+
+pub fn read(path: &Path, size: f64) -> Result<World, BadInput> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| bad_input!("cannot read scene file {}: {e}", path.display()))?;
+    parse(&text, size, &path.display().to_string())
+}
+
+/// Parse CSV text; `name` prefixes every message (`file.csv line 7: ...`).
+pub fn parse(text: &str, size: f64, name: &str) -> Result<World, BadInput> {
+    let mut rdr = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    let header = rdr
+        .headers()
+        .map_err(|e| bad_input!("{name} line 1: cannot read the header: {e}"))?
+        .clone();
+    if header.iter().collect::<Vec<_>>() != HEADER {
+        return bad!(
+            "{name} line 1: header must be `{}`, got `{}`",
+            HEADER.join(","),
+            header.iter().collect::<Vec<_>>().join(",")
+        );
+    }
+    let mut spheres = Vec::new();
+    let mut lines = Vec::new();
+    for rec in rdr.records() {
+        let rec = rec.map_err(|e| {
+            let line = e.position().map_or(0, |p| p.line());
+            bad_input!("{name} line {line}: {e}")
+        })?;
+        let line = rec.position().map_or(0, |p| p.line());
+        if rec.len() != 8 {
+            return bad!("{name} line {line}: expected 8 fields, found {}", rec.len());
+        }
+        let mut v = [0.0; 8];
+        for (k, (slot, field)) in v.iter_mut().zip(rec.iter()).enumerate() {
+            *slot = field.parse().map_err(|_| {
+                bad_input!(
+                    "{name} line {line}: {} = `{field}` is not a number",
+                    HEADER[k]
+                )
+            })?;
+        }
+        spheres.push(Sphere {
+            pos: DVec3::new(v[0], v[1], v[2]),
+            vel: DVec3::new(v[3], v[4], v[5]),
+            radius: v[6],
+            mass: v[7],
+        });
+        lines.push(line);
+    }
+    let world = World::new(size, spheres);
+    check(&world, &|i| format!("{name} line {}", lines[i]))?;
+    Ok(world)
+}
+
+pub fn write(world: &World, out: &mut impl Write) -> std::io::Result<()> {
+    writeln!(out, "{}", HEADER.join(","))?;
+    for s in &world.spheres {
+        writeln!(
+            out,
+            "{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?}",
+            s.pos.x, s.pos.y, s.pos.z, s.vel.x, s.vel.y, s.vel.z, s.radius, s.mass
+        )?;
+    }
+    Ok(())
+}
+
+pub fn dump(world: &World, path: &Path) -> Result<(), BadInput> {
+    let file = std::fs::File::create(path)
+        .map_err(|e| bad_input!("cannot write {}: {e}", path.display()))?;
+    let mut w = std::io::BufWriter::new(file);
+    write(world, &mut w)
+        .and_then(|_| w.flush())
+        .map_err(|e| bad_input!("cannot write {}: {e}", path.display()))
+}

@@ -1,0 +1,272 @@
+//! Putting spheres into the cube without overlaps, and setting them moving.
+use super::presets::{Layout, Preset};
+use crate::bad;
+use crate::error::BadInput;
+use crate::physics::sphere::volume;
+use crate::physics::{Sphere, World};
+use glam::DVec3;
+use rand::seq::SliceRandom;
+use rand::{Rng, SeedableRng};
+use rand_distr::{Distribution, StandardNormal};
+use rand_xoshiro::Xoshiro256PlusPlus;
+use std::collections::HashMap;
+
+pub type SceneRng = Xoshiro256PlusPlus;
+
+pub fn rng(seed: u64) -> SceneRng {
+    Xoshiro256PlusPlus::seed_from_u64(seed)
+}
+
+/// Random tries per sphere before random placement gives up.
+const TRIES: usize = 2000;
+
+/// Build the spheres of `preset` with the given (already validated) values.
+pub fn generate(
+    preset: &Preset,
+    count: usize,
+    radius: f64,
+    speed: f64,
+    size: f64,
+    rng: &mut SceneRng,
+) -> Result<World, BadInput> {
+    let positions = match preset.layout {
+        Layout::Cradle => return cradle(count, radius, speed, size),
+        Layout::Lattice => lattice(&vec![radius; count], size, rng)?,
+        Layout::Mixed => {
+            let mut radii: Vec<f64> = (0..count)
+                .map(|_| radius * 10f64.powf(rng.random_range(-1.0..=1.0)))
+                .collect();
+            // Largest first: the big ones need the room.
+            radii.sort_by(|a, b| b.total_cmp(a));
+            random_or_lattice(&radii, size, rng)?
+        }
+        Layout::Gas | Layout::Uniform => random_or_lattice(&vec![radius; count], size, rng)?,
+    };
+    let mut spheres: Vec<Sphere> = positions
+        .into_iter()
+        .map(|(p, r)| Sphere::new(p, DVec3::ZERO, r))
+        .collect();
+    match preset.layout {
+        Layout::Uniform => {
+            for s in &mut spheres {
+                s.vel = random_direction(rng) * speed;
+            }
+        }
+        _ => maxwell(&mut spheres, speed, rng),
+    }
+    Ok(World::new(size, spheres))
+}
+
+pub fn random_direction(rng: &mut SceneRng) -> DVec3 {
+    loop {
+        let v = DVec3::new(
+            rng.sample(StandardNormal),
+            rng.sample(StandardNormal),
+            rng.sample(StandardNormal),
+        );
+        let len = v.length();
+        if len > 1e-9 {
+            return v / len;
+        }
+    }
+}
+
+/// Gaussian components, no net momentum, rescaled to rms speed `speed`.
+fn maxwell(spheres: &mut [Sphere], speed: f64, rng: &mut SceneRng) {
+    if spheres.is_empty() {
+        return;
+    }
+    for s in spheres.iter_mut() {
+        let g: [f64; 3] = std::array::from_fn(|_| StandardNormal.sample(rng));
+        s.vel = DVec3::from_array(g);
+    }
+    if spheres.len() > 1 {
+        let m: f64 = spheres.iter().map(|s| s.mass).sum();
+        let p: DVec3 = spheres.iter().map(|s| s.mass * s.vel).sum();
+        for s in spheres.iter_mut() {
+            s.vel -= p / m;
+        }
+    }
+    let ms = spheres.iter().map(|s| s.vel.length_squared()).sum::<f64>() / spheres.len() as f64;
+    let scale = if ms > 0.0 { speed / ms.sqrt() } else { 0.0 };
+    for s in spheres.iter_mut() {
+        s.vel *= scale;
+    }
+}
+
+fn cradle(count: usize, radius: f64, speed: f64, size: f64) -> Result<World, BadInput> {
+    let gap = 2.0 * radius;
+    let need = 2.0 * radius * count as f64 + if count > 1 { gap } else { 0.0 };
+    if need > size {
+        return bad!(
+            "the cradle needs {need} box lengths for {count} spheres of radius {radius}, but the box is {size}"
+        );
+    }
+    let c = 0.5 * size;
+    let start = c - 0.5 * need + radius;
+    let spheres = (0..count)
+        .map(|i| {
+            let x = if i == 0 {
+                start
+            } else {
+                start + gap + 2.0 * radius * i as f64
+            };
+            let v = if i == 0 { speed } else { 0.0 };
+            Sphere::new(DVec3::new(x, c, c), DVec3::new(v, 0.0, 0.0), radius)
+        })
+        .collect();
+    Ok(World::new(size, spheres))
+}
+
+fn random_or_lattice(
+    radii: &[f64],
+    size: f64,
+    rng: &mut SceneRng,
+) -> Result<Vec<(DVec3, f64)>, BadInput> {
+    match random(radii, size, rng) {
+        Some(p) => Ok(p),
+        None => lattice(radii, size, rng),
+    }
+}
+
+/// Random sequential placement with a hash grid; `None` when a sphere finds
+/// no free spot in `TRIES` tries.
+fn random(radii: &[f64], size: f64, rng: &mut SceneRng) -> Option<Vec<(DVec3, f64)>> {
+    let rmax = radii.iter().copied().fold(0.0, f64::max);
+    if radii.is_empty() {
+        return Some(Vec::new());
+    }
+    if 2.0 * rmax >= size {
+        return None;
+    }
+    let cell = 2.0 * rmax;
+    let key = |p: DVec3| (p / cell).floor().as_ivec3().to_array();
+    let mut grid: HashMap<[i32; 3], Vec<usize>> = HashMap::new();
+    let mut out: Vec<(DVec3, f64)> = Vec::with_capacity(radii.len());
+    for &r in radii {
+        let mut placed = false;
+        for _ in 0..TRIES {
+            let p = DVec3::new(
+                rng.random_range(r..=size - r),
+                rng.random_range(r..=size - r),
+                rng.random_range(r..=size - r),
+            );
+            let k = key(p);
+            let free = (-1..=1).all(|dx| {
+                (-1..=1).all(|dy| {
+                    (-1..=1).all(|dz| {
+                        grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz])
+                            .is_none_or(|v| {
+                                v.iter().all(|&j| {
+                                    let (q, rq) = out[j];
+                                    p.distance_squared(q) >= (r + rq) * (r + rq)
+                                })
+                            })
+                    })
+                })
+            });
+            if free {
+                grid.entry(k).or_default().push(out.len());
+                out.push((p, r));
+                placed = true;
+                break;
+            }
+        }
+        if !placed {
+            return None;
+        }
+    }
+    Some(out)
+}
+
+/// A cubic lattice of pitch `2 r_max` or more, sites chosen at random, each
+/// sphere jittered within its site. Fails with a message when it can't fit.
+fn lattice(radii: &[f64], size: f64, rng: &mut SceneRng) -> Result<Vec<(DVec3, f64)>, BadInput> {
+    let n = radii.len();
+    if n == 0 {
+        return Ok(Vec::new());
+    }
+    let rmax = radii.iter().copied().fold(0.0, f64::max);
+    let per_side = (size / (2.0 * rmax)).floor() as usize;
+    if per_side == 0 || per_side.saturating_pow(3) < n {
+        let fraction: f64 = radii.iter().map(|&r| volume(r)).sum::<f64>() / size.powi(3);
+        return bad!(
+            "cannot fit {n} spheres (largest radius {rmax}) in a box of {size}: packing fraction {fraction:.3}, at most {} fit on a lattice",
+            per_side.saturating_pow(3)
+        );
+    }
+    let pitch = size / per_side as f64;
+    let mut sites: Vec<usize> = (0..per_side.pow(3)).collect();
+    sites.shuffle(rng);
+    Ok(radii
+        .iter()
+        .zip(sites)
+        .map(|(&r, site)| {
+            let idx = [
+                site % per_side,
+                (site / per_side) % per_side,
+                site / (per_side * per_side),
+            ];
+            let slack = 0.5 * pitch - r;
+            let p = DVec3::from_array(idx.map(|i| {
+                let centre = (i as f64 + 0.5) * pitch;
+                centre
+                    + if slack > 0.0 {
+                        rng.random_range(-slack..=slack)
+                    } else {
+                        0.0
+                    }
+            }));
+            (p, r)
+        })
+        .collect())
+}
+
+/// Why a world is not a valid scene, if it isn't: centres outside the cube,
+/// overlaps, non-finite or non-positive values. `what(i)` names sphere `i`
+/// in the message (e.g. its CSV line).
+pub fn check(world: &World, what: &dyn Fn(usize) -> String) -> Result<(), BadInput> {
+    let size = world.size;
+    let tol = 1e-9 * size;
+    for (i, s) in world.spheres.iter().enumerate() {
+        if !(s.pos.is_finite() && s.vel.is_finite() && s.radius.is_finite() && s.mass.is_finite()) {
+            return bad!("{}: a value is not a finite number", what(i));
+        }
+        if s.radius <= 0.0 {
+            return bad!("{}: radius must be positive, got {}", what(i), s.radius);
+        }
+        if s.mass <= 0.0 {
+            return bad!("{}: mass must be positive, got {}", what(i), s.mass);
+        }
+        if 2.0 * s.radius > size {
+            return bad!(
+                "{}: radius {} does not fit in a box of {size}",
+                what(i),
+                s.radius
+            );
+        }
+        for k in 0..3 {
+            if s.pos[k] < s.radius - tol || s.pos[k] > size - s.radius + tol {
+                return bad!(
+                    "{}: sphere at {:?} with radius {} is outside the cube [0, {size}]^3",
+                    what(i),
+                    s.pos.to_array(),
+                    s.radius
+                );
+            }
+        }
+    }
+    let mut first: Option<(usize, usize, f64)> = None;
+    crate::physics::broad::for_each_near_pair(&world.spheres, size, |i, j| {
+        let (a, b) = (&world.spheres[i], &world.spheres[j]);
+        let sum = a.radius + b.radius;
+        let d = a.pos.distance(b.pos);
+        if d < sum * (1.0 - 1e-12) && first.is_none_or(|f| (i.min(j), i.max(j)) < (f.0, f.1)) {
+            first = Some((i.min(j), i.max(j), sum - d));
+        }
+    });
+    if let Some((i, j, depth)) = first {
+        return bad!("{} and {} overlap by {depth}", what(i), what(j));
+    }
+    Ok(())
+}

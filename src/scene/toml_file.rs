@@ -1,0 +1,62 @@
+//! TOML scene files: a preset with overrides, and/or explicit spheres.
+//!
+//! ```toml
+//! preset = "gas"          # optional, default "gas"
+//! count = 500             # optional overrides, as the flags
+//! radius = 0.02
+//! speed = 0.5
+//! seed = 7
+//! box = 1.0
+//! [[sphere]]              # optional: explicit spheres replace generated ones
+//! pos = [0.5, 0.5, 0.5]
+//! vel = [0.1, 0.0, 0.0]
+//! radius = 0.05
+//! mass = 1.0              # optional, default: volume (density 1)
+//! ```
+use crate::error::BadInput;
+use crate::{bad, bad_input};
+use serde::Deserialize;
+use std::path::Path;
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    pub preset: Option<String>,
+    pub count: Option<usize>,
+    pub radius: Option<f64>,
+    pub speed: Option<f64>,
+    pub seed: Option<u64>,
+    #[serde(rename = "box")]
+    pub size: Option<f64>,
+    #[serde(default)]
+    pub sphere: Vec<SphereEntry>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SphereEntry {
+    pub pos: [f64; 3],
+    #[serde(default)]
+    pub vel: [f64; 3],
+    pub radius: f64,
+    pub mass: Option<f64>,
+}
+
+pub fn read(path: &Path) -> Result<SceneFile, BadInput> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| bad_input!("cannot read scene file {}: {e}", path.display()))?;
+    parse(&text, &path.display().to_string())
+}
+
+pub fn parse(text: &str, name: &str) -> Result<SceneFile, BadInput> {
+    toml::from_str(text).or_else(|e: toml::de::Error| {
+        let line = e
+            .span()
+            .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+        let msg = e.message().to_string();
+        match line {
+            Some(l) => bad!("{name} line {l}: {msg}"),
+            None => bad!("{name}: {msg}"),
+        }
+    })
+}

@@ -1,0 +1,156 @@
+//! The binary's command line: bench JSON, --dump, and bad input (exit 2).
+use assert_cmd::Command;
+
+fn ballpit() -> Command {
+    Command::cargo_bin("ballpit").unwrap()
+}
+
+fn json(args: &[&str]) -> serde_json::Value {
+    let out = ballpit().arg("bench").args(args).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn bench_prints_one_json_line_with_every_field() {
+    let v = json(&["--steps", "30", "--count", "200"]);
+    for field in [
+        "n",
+        "steps",
+        "dt",
+        "model",
+        "threading",
+        "threads",
+        "wall_seconds",
+        "steps_per_second",
+        "sphere_steps_per_second",
+        "energy_start",
+        "energy_end",
+        "energy_drift_rel",
+        "max_energy_err_rel",
+        "escaped",
+        "max_overlap_rel",
+        "sphere_collisions",
+        "wall_collisions",
+        "wall_pressure",
+        "thread_cpu",
+        "peak_rss_bytes",
+        "capped_steps",
+    ] {
+        assert!(v.get(field).is_some(), "missing {field}");
+    }
+    assert_eq!(v["n"], 200);
+    assert_eq!(v["steps"], 30);
+    assert_eq!(v["model"], "swept");
+    assert_eq!(v["escaped"], 0);
+    assert!(v["energy_drift_rel"].as_f64().unwrap() < 1e-12);
+    assert!(v["peak_rss_bytes"].as_u64().unwrap() > 0);
+}
+
+#[test]
+fn dump_reads_back_as_the_same_scene() {
+    let dir = std::env::temp_dir().join(format!("ballpit-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let a = dir.join("a.csv");
+    let b = dir.join("b.csv");
+    json(&[
+        "--scene",
+        "billiards",
+        "--steps",
+        "10",
+        "--dump",
+        a.to_str().unwrap(),
+    ]);
+    // Zero steps from the dump must write it back byte for byte.
+    let v = json(&[
+        "--scene",
+        a.to_str().unwrap(),
+        "--steps",
+        "0",
+        "--dump",
+        b.to_str().unwrap(),
+    ]);
+    assert_eq!(v["n"], 8);
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bad_input_exits_2_with_one_clear_message() {
+    let dir = std::env::temp_dir().join(format!("ballpit-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let overlap = dir.join("overlap.csv");
+    std::fs::write(
+        &overlap,
+        "x,y,z,vx,vy,vz,radius,mass\n0.5,0.5,0.5,0,0,0,0.1,1\n0.55,0.5,0.5,0,0,0,0.1,1\n",
+    )
+    .unwrap();
+    let broken = dir.join("broken.toml");
+    std::fs::write(&broken, "count = [\n").unwrap();
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (vec!["--count=-3".into()], "--count"),
+        (vec!["--count".into(), "ten".into()], "--count"),
+        (vec!["--radius".into(), "0".into()], "--radius must be"),
+        (vec!["--radius".into(), "NaN".into()], "--radius must be"),
+        (vec!["--radius".into(), "0.6".into()], "too big"),
+        (vec!["--speed".into(), "inf".into()], "--speed must be"),
+        (vec!["--box=-1".into()], "--box must be"),
+        (vec!["--dt".into(), "0".into()], "--dt must be"),
+        (vec!["--tick=-1".into()], "--tick"),
+        (vec!["--threads".into(), "0".into()], "--threads must be"),
+        (
+            vec!["--model".into(), "magic".into()],
+            "unknown model 'magic'",
+        ),
+        (
+            vec!["--threading".into(), "many".into()],
+            "unknown threading 'many'",
+        ),
+        (
+            vec!["--scene".into(), "moon".into()],
+            "unknown scene 'moon'",
+        ),
+        (
+            vec!["--scene".into(), "/nonexistent.csv".into()],
+            "cannot read scene file",
+        ),
+        (
+            vec!["--scene".into(), overlap.to_str().unwrap().into()],
+            "overlap",
+        ),
+        (
+            vec!["--scene".into(), broken.to_str().unwrap().into()],
+            "line",
+        ),
+        (
+            vec![
+                "--count".into(),
+                "100000".into(),
+                "--radius".into(),
+                "0.1".into(),
+            ],
+            "cannot fit",
+        ),
+    ];
+    for (args, want) in cases {
+        let out = ballpit()
+            .arg("bench")
+            .arg("--steps")
+            .arg("1")
+            .args(&args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(want), "{args:?}: got `{err}`, want `{want}`");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert!(out.stdout.is_empty(), "{args:?}");
+    }
+    let out = ballpit().arg("bench").output().unwrap();
+    assert_eq!(out.status.code(), Some(2), "missing --steps");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
