@@ -8,3 +8,4 @@ pub mod engine;
 pub mod error;
 pub mod physics;
 pub mod scene;
+pub mod tradeoff;
