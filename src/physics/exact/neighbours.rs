@@ -20,9 +20,12 @@ use glam::DVec3;
 const NONE: u32 = u32::MAX;
 /// A sphere counts as large (second level) above this multiple of the bulk radius.
 const BIG_FACTOR: f64 = 3.0;
-/// Skin as a fraction of the bulk radius, at least (Smallenburg's 1.5 shell).
+/// Skin as a fraction of the bulk radius, at least: a quarter diameter
+/// (Smallenburg's 1.5 shell), best for dense scenes.
 const SKIN_MIN_RADII: f64 = 0.5;
-/// Dilute scenes get a wider skin: about this many neighbours per sphere.
+/// Dilute scenes get a wider skin, about this many neighbours per sphere:
+/// a rebuild has a fixed cost, so rebuilding less often pays for the longer
+/// lists (measured at N = 4000, packing 0.05 to 0.45).
 const TARGET_NEIGHBOURS: f64 = 12.0;
 /// Relist a little before the skin is used up, so rounding in the lazy
 /// positions can never let a non-neighbour slip into contact.
@@ -35,6 +38,14 @@ struct Centre {
     radius: f64,
 }
 
+/// One entry of a neighbour list: the neighbour, and where this sphere sits
+/// in the neighbour's own list, so unlinking a pair is O(1) both ways.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Link {
+    pub j: u32,
+    back: u32,
+}
+
 /// Neighbour lists of the bulk spheres in one flat array with a fixed
 /// stride (no pointer per list; the stride doubles if a list ever fills),
 /// and separate growable lists for the few large spheres, whose neighbours
@@ -42,18 +53,18 @@ struct Centre {
 #[derive(Clone, Debug, Default)]
 struct Lists {
     stride: usize,
-    flat: Vec<u32>,
+    flat: Vec<Link>,
     len: Vec<u32>,
     /// Index into `big` for second-level spheres, else `NONE`.
     slot: Vec<u32>,
-    big: Vec<Vec<u32>>,
+    big: Vec<Vec<Link>>,
 }
 
 impl Lists {
     fn reset(&mut self, n: usize) {
         self.stride = 32;
         self.flat.clear();
-        self.flat.resize(n * self.stride, 0);
+        self.flat.resize(n * self.stride, Link::default());
         self.len.clear();
         self.len.resize(n, 0);
         self.slot.clear();
@@ -67,7 +78,7 @@ impl Lists {
     }
 
     #[inline]
-    fn of(&self, i: usize) -> &[u32] {
+    fn of(&self, i: usize) -> &[Link] {
         match self.slot[i] {
             NONE => &self.flat[i * self.stride..i * self.stride + self.len[i] as usize],
             s => &self.big[s as usize],
@@ -75,40 +86,59 @@ impl Lists {
     }
 
     #[inline]
-    fn push(&mut self, i: usize, j: u32) {
+    fn of_mut(&mut self, i: usize) -> &mut [Link] {
+        match self.slot[i] {
+            NONE => &mut self.flat[i * self.stride..i * self.stride + self.len[i] as usize],
+            s => &mut self.big[s as usize],
+        }
+    }
+
+    #[inline]
+    fn push(&mut self, i: usize, l: Link) {
         match self.slot[i] {
             NONE => {
                 if self.len[i] as usize == self.stride {
                     self.grow();
                 }
-                self.flat[i * self.stride + self.len[i] as usize] = j;
+                self.flat[i * self.stride + self.len[i] as usize] = l;
                 self.len[i] += 1;
             }
-            s => self.big[s as usize].push(j),
+            s => self.big[s as usize].push(l),
         }
     }
 
     #[inline]
-    fn remove(&mut self, i: usize, j: u32) {
+    fn pop(&mut self, i: usize) {
         match self.slot[i] {
-            NONE => {
-                let start = i * self.stride;
-                let l = &mut self.flat[start..start + self.len[i] as usize];
-                if let Some(k) = l.iter().position(|&x| x == j) {
-                    l[k] = l[l.len() - 1];
-                    self.len[i] -= 1;
-                }
-            }
+            NONE => self.len[i] -= 1,
             s => {
-                let l = &mut self.big[s as usize];
-                if let Some(k) = l.iter().position(|&x| x == j) {
-                    l.swap_remove(k);
-                }
+                self.big[s as usize].pop();
             }
         }
     }
 
-    fn clear(&mut self, i: usize) {
+    /// Make `i` and `j` neighbours.
+    #[inline]
+    fn link(&mut self, i: usize, j: usize) {
+        let (li, lj) = (self.of(i).len() as u32, self.of(j).len() as u32);
+        self.push(i, Link { j: j as u32, back: lj });
+        self.push(j, Link { j: i as u32, back: li });
+    }
+
+    /// Remove `i` from all its neighbours' lists and empty its own.
+    fn unlink_all(&mut self, i: usize) {
+        for k in 0..self.of(i).len() {
+            let Link { j, back } = self.of(i)[k];
+            let j = j as usize;
+            let last = self.of(j).len() - 1;
+            if back as usize != last {
+                // Move j's last entry into the hole and repoint its partner.
+                let moved = self.of(j)[last];
+                self.of_mut(j)[back as usize] = moved;
+                self.of_mut(moved.j as usize)[moved.back as usize].back = back;
+            }
+            self.pop(j);
+        }
         match self.slot[i] {
             NONE => self.len[i] = 0,
             s => self.big[s as usize].clear(),
@@ -118,10 +148,11 @@ impl Lists {
     fn grow(&mut self) {
         let old = self.stride;
         self.stride *= 2;
-        let mut flat = vec![0; self.len.len() * self.stride];
+        let mut flat = vec![Link::default(); self.len.len() * self.stride];
         for (i, &l) in self.len.iter().enumerate() {
             let l = l as usize;
-            flat[i * self.stride..i * self.stride + l].copy_from_slice(&self.flat[i * old..i * old + l]);
+            flat[i * self.stride..i * self.stride + l]
+                .copy_from_slice(&self.flat[i * old..i * old + l]);
         }
         self.flat = flat;
     }
@@ -182,12 +213,17 @@ impl Neighbours {
         // Ideal-gas estimate of the distance that holds TARGET_NEIGHBOURS.
         let density = n as f64 / (size * size * size);
         let reach = (TARGET_NEIGHBOURS / (density * 4.0 / 3.0 * std::f64::consts::PI)).cbrt();
-        let skin = (SKIN_MIN_RADII * bulk).max(0.5 * (reach - 2.0 * bulk));
-        self.skin = skin.min(0.25 * size).max(1e-12 * size);
-        let cell_min = 2.0 * (self.small_rmax + self.skin);
+        let skin = (SKIN_MIN_RADII * bulk)
+            .max(0.5 * (reach - 2.0 * bulk))
+            .clamp(1e-12 * size, 0.25 * size);
+        let cell_min = 2.0 * (self.small_rmax + skin);
+        // At most ~4 cells per sphere keeps memory O(N).
         let cap = ((4 * n) as f64).cbrt().ceil().clamp(1.0, 256.0);
         self.per_side = (size / cell_min).floor().clamp(1.0, cap) as usize;
         self.inv_cell = self.per_side as f64 / size;
+        // Cells larger than needed (few or tiny spheres): widen the skin to
+        // fill them, which costs no more per rebuild and rebuilds less often.
+        self.skin = (0.5 * size / self.per_side as f64 - self.small_rmax).max(skin);
         self.head.clear();
         self.head.resize(self.per_side.pow(3), NONE);
         for (i, b) in bodies.iter().enumerate() {
@@ -205,11 +241,7 @@ impl Neighbours {
 
     /// Sphere `i` (moved to the current time) gets a new centre and list.
     pub fn rebuild(&mut self, i: usize, bodies: &[Body]) {
-        for k in 0..self.lists.of(i).len() {
-            let j = self.lists.of(i)[k];
-            self.lists.remove(j as usize, i as u32);
-        }
-        self.lists.clear(i);
+        self.lists.unlink_all(i);
         self.centre[i].pos = bodies[i].pos;
         if self.cell[i] != NONE {
             self.remove(i);
@@ -219,7 +251,7 @@ impl Neighbours {
     }
 
     #[inline]
-    pub fn of(&self, i: usize) -> &[u32] {
+    pub fn of(&self, i: usize) -> &[Link] {
         self.lists.of(i)
     }
 
@@ -254,8 +286,7 @@ impl Neighbours {
             let c = &centre[j];
             let s = ri + c.radius;
             if (ci - c.pos).length_squared() < s * s {
-                lists.push(i, j as u32);
-                lists.push(j, i as u32);
+                lists.link(i, j);
             }
         };
         let reach = if self.cell[i] == NONE {

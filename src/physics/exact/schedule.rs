@@ -4,6 +4,7 @@
 //! a contact stays valid while the partner's collision count is unchanged,
 //! and is recomputed when it comes due otherwise.
 use super::body::Body;
+use super::neighbours::Link;
 use crate::physics::contact::{pair_toi, wall_toi};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -33,7 +34,7 @@ pub struct Event {
 #[inline]
 pub fn predict(
     a: &Body,
-    neighbours: &[u32],
+    neighbours: &[Link],
     bodies: &[Body],
     counts: &[u32],
     size: f64,
@@ -54,7 +55,7 @@ pub fn predict(
             ..Event::default()
         };
     }
-    for &j in neighbours {
+    for &Link { j, .. } in neighbours {
         let b = &bodies[j as usize];
         let dp = a.pos - b.pos_at(now);
         let dv = a.vel - b.vel;
