@@ -211,7 +211,10 @@ pub fn svg(rows: &[Row], path: &Path) -> anyhow::Result<()> {
     let root = SVGBackend::new(path, (800, 560)).into_drawing_area();
     root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(&root)
-        .caption("ballpit tradeoff: position error vs cost", ("sans-serif", 22))
+        .caption(
+            "ballpit tradeoff: position error vs cost",
+            ("sans-serif", 22),
+        )
         .margin(16)
         .x_label_area_size(48)
         .y_label_area_size(72)

@@ -20,10 +20,13 @@ fn check_invariants(w: &World, e0: f64, energy_tol: f64, overlap_tol: f64) {
 #[test]
 fn head_on_pair_meets_at_the_predicted_time_and_swaps_velocities() {
     // Gap 0.2 closing at 2 L/s: contact at t = 0.1, then equal masses swap.
-    let mut w = World::new(1.0, vec![
-        sphere([0.3, 0.5, 0.5], [1.0, 0.0, 0.0], 0.1),
-        sphere([0.7, 0.5, 0.5], [-1.0, 0.0, 0.0], 0.1),
-    ]);
+    let mut w = World::new(
+        1.0,
+        vec![
+            sphere([0.3, 0.5, 0.5], [1.0, 0.0, 0.0], 0.1),
+            sphere([0.7, 0.5, 0.5], [-1.0, 0.0, 0.0], 0.1),
+        ],
+    );
     let mut m = Exact::default();
     m.advance(&mut w, 0.25, 1, &Serial);
     assert_eq!(w.counters.sphere_collisions, 1);

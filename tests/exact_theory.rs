@@ -90,10 +90,19 @@ fn check(packing: f64, seed: u64, wall: (f64, f64)) {
         100.0 * (p_virial / p_cs - 1.0),
         100.0 * (p_wall / p_cs - 1.0),
     );
-    assert!((rate / enskog - 1.0).abs() < 0.03, "rate {rate} vs Enskog {enskog}");
-    assert!((p_virial / p_cs - 1.0).abs() < 0.03, "P {p_virial} vs CS {p_cs}");
+    assert!(
+        (rate / enskog - 1.0).abs() < 0.03,
+        "rate {rate} vs Enskog {enskog}"
+    );
+    assert!(
+        (p_virial / p_cs - 1.0).abs() < 0.03,
+        "P {p_virial} vs CS {p_cs}"
+    );
     let excess = p_wall / p_cs - 1.0;
-    assert!(excess > wall.0 && excess < wall.1, "wall P {p_wall} vs CS {p_cs}");
+    assert!(
+        excess > wall.0 && excess < wall.1,
+        "wall P {p_wall} vs CS {p_cs}"
+    );
 }
 
 #[test]

@@ -48,7 +48,11 @@ fn cli_writes_the_table_the_csv_and_the_plot() {
         .arg(&dir)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let table = String::from_utf8(out.stdout).unwrap();
     assert_eq!(table.lines().count(), 2 + 3 * LADDER.len());
     assert!(table.contains("| exact | 1/1920 |"));

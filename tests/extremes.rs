@@ -38,13 +38,19 @@ fn run(name: &str, kind: ModelKind, world: &World, dt: f64, steps: u64) -> Outco
     for step in 0..steps {
         let capped = w.counters.capped_steps;
         model.advance(&mut w, dt, 1, &Serial);
-        assert!(!w.has_non_finite(), "{name} {kind}: non-finite at step {step}");
+        assert!(
+            !w.has_non_finite(),
+            "{name} {kind}: non-finite at step {step}"
+        );
         let de = if e0 > 0.0 {
             (w.kinetic_energy() - e0).abs() / e0
         } else {
             w.kinetic_energy()
         };
-        assert!(de <= ENERGY, "{name} {kind}: energy error {de:e} at step {step}");
+        assert!(
+            de <= ENERGY,
+            "{name} {kind}: energy error {de:e} at step {step}"
+        );
         assert_eq!(w.escaped(), 0, "{name} {kind}: escaped at step {step}");
         if check_overlap {
             let ov = w.max_overlap_rel();
@@ -136,7 +142,11 @@ fn radius_from_a_millionth_to_just_under_half_the_box() {
     // Swept and exact take every bounce (~16 000 per step on y); discrete
     // mirrors once per step and axis.
     for o in &out[1..] {
-        assert!(o.world.counters.wall_collisions > 100_000, "{:?}", o.world.counters);
+        assert!(
+            o.world.counters.wall_collisions > 100_000,
+            "{:?}",
+            o.world.counters
+        );
     }
     assert!(out[0].world.counters.wall_collisions <= 30);
 }
@@ -169,8 +179,9 @@ fn mass_ratios_of_a_million_either_way() {
     let w = World::new(1.0, vec![a, b]);
     let out = run("ratio", ModelKind::Exact, &w, 0.1, 2);
     let (m1, m2) = (a.mass, b.mass);
-    let v1 = ((m1 - m2) * 1.0 + 2.0 * m2 * -1.0) / (m1 + m2);
-    let v2 = ((m2 - m1) * -1.0 + 2.0 * m1 * 1.0) / (m1 + m2);
+    let (u1, u2) = (a.vel.x, b.vel.x);
+    let v1 = ((m1 - m2) * u1 + 2.0 * m2 * u2) / (m1 + m2);
+    let v2 = ((m2 - m1) * u2 + 2.0 * m1 * u1) / (m1 + m2);
     assert_eq!(out.world.counters.sphere_collisions, 1);
     assert!((out.world.spheres[0].vel.x - v1).abs() < 1e-12);
     assert!((out.world.spheres[1].vel.x - v2).abs() < 1e-9 * v2.abs());
@@ -182,14 +193,22 @@ fn mass_ratios_of_a_million_either_way() {
     // Light spheres rattling between heavy ones speed up fast (energy flows
     // towards equipartition), so the collision rate climbs: keep it short.
     let out = all("masses", &w, 1.0 / 120.0, 10);
-    assert!(out[2].world.counters.sphere_collisions > 500, "{:?}", out[2].world.counters);
+    assert!(
+        out[2].world.counters.sphere_collisions > 500,
+        "{:?}",
+        out[2].world.counters
+    );
 }
 
 #[test]
 fn packing_up_to_one_half() {
     let w = lattice_world(1000, 0.5, 1.0, 3).unwrap();
     let out = all("packing 0.5", &w, 1.0 / 120.0, 12);
-    assert!(out[2].world.counters.sphere_collisions > 500, "{:?}", out[2].world.counters);
+    assert!(
+        out[2].world.counters.sphere_collisions > 500,
+        "{:?}",
+        out[2].world.counters
+    );
     assert_eq!(out[2].world.counters.capped_steps, 0);
 }
 
@@ -275,8 +294,14 @@ fn grazing_contacts() {
             ],
         );
         let out = all("graze", &w, 1.0 / 60.0, 30);
-        assert_eq!(out[2].world.counters.sphere_collisions, hits, "offset {offset}");
-        assert_eq!(out[1].world.counters.sphere_collisions, hits, "offset {offset}");
+        assert_eq!(
+            out[2].world.counters.sphere_collisions, hits,
+            "offset {offset}"
+        );
+        assert_eq!(
+            out[1].world.counters.sphere_collisions, hits,
+            "offset {offset}"
+        );
     }
 }
 
@@ -297,12 +322,18 @@ fn impossible_requests_exit_2() {
     for args in [
         &["bench", "--steps", "1", "--count", "1", "--radius", "0.5"][..],
         &["bench", "--steps", "1", "--dt", "0"],
-        &["bench", "--steps", "1", "--count", "100000", "--radius", "0.1"],
+        &[
+            "bench", "--steps", "1", "--count", "100000", "--radius", "0.1",
+        ],
         &["bench", "--steps", "1", "--speed", "NaN"],
         &["bench", "--steps", "1", "--model", "psychic"],
         &["tradeoff", "--radius=-1"],
     ] {
-        let out = Command::cargo_bin("ballpit").unwrap().args(args).output().unwrap();
+        let out = Command::cargo_bin("ballpit")
+            .unwrap()
+            .args(args)
+            .output()
+            .unwrap();
         assert_eq!(out.status.code(), Some(2), "{args:?}");
         // One message (clap adds a line pointing to --help).
         let err = String::from_utf8_lossy(&out.stderr);
@@ -311,4 +342,3 @@ fn impossible_requests_exit_2() {
         assert!(!err.contains("panicked"), "{args:?}: {err}");
     }
 }
-

@@ -61,9 +61,7 @@ fn scene(seeds: &[Seed]) -> World {
             pos.x = r;
         }
         let inside = (0..3).all(|k| pos[k] >= r && pos[k] <= 1.0 - r);
-        let clear = spheres
-            .iter()
-            .all(|o| o.pos.distance(pos) >= o.radius + r);
+        let clear = spheres.iter().all(|o| o.pos.distance(pos) >= o.radius + r);
         if inside && clear {
             let mut sp = Sphere::new(pos, vel, r);
             sp.mass = 10f64.powf(s.mass_exp);
@@ -83,7 +81,10 @@ fn check_run(world: &World, dt: f64, steps: u64) -> Result<World, TestCaseError>
         prop_assert!(!w.has_non_finite());
         prop_assert_eq!(w.escaped(), 0);
         let de = (w.kinetic_energy() - e0).abs();
-        prop_assert!(de <= 1e-10 * e0.max(f64::MIN_POSITIVE), "energy {de:e} of {e0:e}");
+        prop_assert!(
+            de <= 1e-10 * e0.max(f64::MIN_POSITIVE),
+            "energy {de:e} of {e0:e}"
+        );
         if w.counters.capped_steps == capped {
             let ov = w.max_overlap_rel();
             prop_assert!(ov <= 1e-9, "overlap {ov:e}");

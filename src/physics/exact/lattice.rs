@@ -41,7 +41,8 @@ pub fn lattice_world(n: usize, packing: f64, speed: f64, seed: u64) -> Result<Wo
                     break 'fill;
                 }
                 let pos = (DVec3::new(x as f64, y as f64, z as f64) + 0.5) * spacing;
-                let g = |rng: &mut Xoshiro256PlusPlus| -> f64 { rng.sample::<f64, _>(StandardNormal) };
+                let g =
+                    |rng: &mut Xoshiro256PlusPlus| -> f64 { rng.sample::<f64, _>(StandardNormal) };
                 let vel = DVec3::new(g(&mut rng), g(&mut rng), g(&mut rng)) * sd;
                 spheres.push(Sphere::new(pos, vel, radius));
             }

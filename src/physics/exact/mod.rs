@@ -210,7 +210,7 @@ impl Exact {
         let mut done = 0u64;
         loop {
             let (t, i) = self.queue.peek();
-            if !(t <= target) {
+            if t.is_nan() || t > target {
                 return true;
             }
             if done == cap {
@@ -238,10 +238,14 @@ impl Exact {
                     let b = &mut self.bodies[i];
                     let mut s = b.sphere(self.mass[i]);
                     let mask = [ev.mask & 1 != 0, ev.mask & 2 != 0, ev.mask & 4 != 0];
-                    for k in 0..3 {
-                        if mask[k] && s.vel[k] != 0.0 {
+                    for (k, &hit) in mask.iter().enumerate() {
+                        if hit && s.vel[k] != 0.0 {
                             // On the wall exactly: lazy positions never drift out.
-                            s.pos[k] = if s.vel[k] < 0.0 { s.radius } else { self.size - s.radius };
+                            s.pos[k] = if s.vel[k] < 0.0 {
+                                s.radius
+                            } else {
+                                self.size - s.radius
+                            };
                         }
                     }
                     let (imp, hits) = reflect_walls(&mut s, mask);

@@ -121,8 +121,20 @@ impl Lists {
     #[inline]
     fn link(&mut self, i: usize, j: usize) {
         let (li, lj) = (self.of(i).len() as u32, self.of(j).len() as u32);
-        self.push(i, Link { j: j as u32, back: lj });
-        self.push(j, Link { j: i as u32, back: li });
+        self.push(
+            i,
+            Link {
+                j: j as u32,
+                back: lj,
+            },
+        );
+        self.push(
+            j,
+            Link {
+                j: i as u32,
+                back: li,
+            },
+        );
     }
 
     /// Remove `i` from all its neighbours' lists and empty its own.
@@ -272,7 +284,11 @@ impl Neighbours {
         // subtracts nearly equal numbers.
         let bb = d.dot(b.vel);
         let disc = (bb * bb - a * c).sqrt();
-        if bb > 0.0 { -c / (bb + disc) } else { (disc - bb) / a }
+        if bb > 0.0 {
+            -c / (bb + disc)
+        } else {
+            (disc - bb) / a
+        }
     }
 
     /// Find the neighbours `j` of `i` (with `want(j)`) and link both ways.
@@ -295,7 +311,10 @@ impl Neighbours {
             0.0
         };
         let (lo, hi) = if self.cell[i] == NONE {
-            (self.coords(ci - DVec3::splat(reach)), self.coords(ci + DVec3::splat(reach)))
+            (
+                self.coords(ci - DVec3::splat(reach)),
+                self.coords(ci + DVec3::splat(reach)),
+            )
         } else {
             let c = self.coords(ci);
             let m = self.per_side - 1;

@@ -43,7 +43,11 @@ pub fn predict(
     let now = a.t;
     let mut best = relist_in;
     let mut ev = Event {
-        kind: if relist_in.is_finite() { Kind::Relist } else { Kind::Idle },
+        kind: if relist_in.is_finite() {
+            Kind::Relist
+        } else {
+            Kind::Idle
+        },
         ..Event::default()
     };
     let (tw, mask) = wall_toi(&a.sphere(0.0), size);
