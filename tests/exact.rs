@@ -169,3 +169,54 @@ fn event_cap_reports_instead_of_hanging() {
     assert_eq!(w.escaped(), 0);
     assert!((w.kinetic_energy() - e0).abs() <= 1e-12 * e0);
 }
+
+#[test]
+fn dense_scene_with_a_large_sphere_uses_lists_with_a_second_level() {
+    let w0 = lattice_world(1000, 0.35, 1.0, 13).unwrap();
+    let r = w0.spheres[0].radius;
+    let centre = DVec3::splat(0.55);
+    let big = 3.4 * r;
+    let mut spheres: Vec<Sphere> = w0
+        .spheres
+        .iter()
+        .filter(|s| s.pos.distance(centre) > big + r + 1e-9)
+        .copied()
+        .collect();
+    spheres.push(Sphere::new(centre, DVec3::new(0.3, 0.1, -0.2), big));
+    let mut w = World::new(1.0, spheres);
+    let filled: f64 = w
+        .spheres
+        .iter()
+        .map(|s| ballpit::physics::sphere::volume(s.radius))
+        .sum();
+    assert!(filled > ballpit::physics::exact::LISTS_ABOVE_PACKING);
+    let e0 = w.kinetic_energy();
+    let mut m = Exact::default();
+    m.advance(&mut w, 1.0 / 60.0, 30, &Serial);
+    assert!(
+        m.stats.relists > 0 && m.stats.crossings == 0,
+        "{:?}",
+        m.stats
+    );
+    let last = w.spheres.len() - 1;
+    assert!(
+        w.spheres[last].vel != DVec3::new(0.3, 0.1, -0.2),
+        "the big one was hit"
+    );
+    check_invariants(&w, e0, 1e-12, 1e-10);
+}
+
+#[test]
+fn dilute_scene_uses_cell_crossings() {
+    let mut w = lattice_world(1000, 0.05, 1.0, 14).unwrap();
+    let e0 = w.kinetic_energy();
+    let mut m = Exact::default();
+    m.advance(&mut w, 1.0 / 60.0, 60, &Serial);
+    assert!(
+        m.stats.crossings > 0 && m.stats.relists == 0,
+        "{:?}",
+        m.stats
+    );
+    assert!(w.counters.sphere_collisions > 1000);
+    check_invariants(&w, e0, 1e-12, 1e-10);
+}

@@ -96,7 +96,10 @@ fn check_run(world: &World, dt: f64, steps: u64) -> Result<World, TestCaseError>
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 192, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig {
+        cases: std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(192),
+        ..ProptestConfig::default()
+    })]
 
     #[test]
     fn random_scenes_keep_every_invariant(
@@ -106,6 +109,23 @@ proptest! {
     ) {
         let w = scene(&seeds);
         check_run(&w, 10f64.powf(dt_exp), steps)?;
+    }
+
+    #[test]
+    fn dense_mixed_scenes_keep_every_invariant(
+        k in 2usize..8,
+        packing in 0.4..0.52f64,
+        seed in 0u64..1000,
+        shrink in prop::collection::vec(0.85..1.0f64, 343),
+        dt_exp in -4.0..-1.0f64,
+    ) {
+        // Lattice starts (the neighbour-list broad phase above packing 0.3),
+        // radii shrunk at random so sizes differ.
+        let mut w = ballpit::physics::exact::lattice::lattice_world(k * k * k, packing, 1.0, seed).unwrap();
+        for (s, f) in w.spheres.iter_mut().zip(&shrink) {
+            *s = Sphere::new(s.pos, s.vel, s.radius * f);
+        }
+        check_run(&w, 10f64.powf(dt_exp), 6)?;
     }
 
     #[test]

@@ -6,17 +6,21 @@
 //!   moved only when an event touches it or when `advance` returns;
 //! - one pending event per sphere (the earliest of contact, wall, or leaving
 //!   its neighbour-list skin), in a tournament tree ([`queue`]);
-//! - neighbour lists built from a cell grid with a second level for large
-//!   spheres ([`neighbours`]);
+//! - a broad phase chosen by packing fraction ([`LISTS_ABOVE_PACKING`]):
+//!   cells with cell-crossing events for dilute and moderate scenes
+//!   ([`cells`]), neighbour lists with a skin for dense ones
+//!   ([`neighbours`]); both keep the few spheres far larger than the bulk on
+//!   a second level, so radii 100x apart stay cheap;
 //! - stale predictions detected by per-sphere collision counts ([`schedule`]).
 //!
 //! Time of impact comes from [`pair_toi`](crate::physics::contact::pair_toi)
 //! (stable quadratic, rounding guard: overlapping and approaching collides
 //! now, receding is left alone). Simultaneous events are processed in sphere
 //! index order: the sphere whose prediction it is, lower index first; a
-//! sphere's own candidates tie relist, then walls, then neighbours in list
-//! order. Runs are therefore reproducible, and the event loop runs on one
-//! thread whatever the executor.
+//! sphere's own candidates tie its broad-phase event (relist or crossing),
+//! then walls, then partners in the order the broad phase offers them.
+//! Runs are therefore reproducible, and the event loop runs on one thread
+//! whatever the executor.
 //!
 //! `dt` is only the sampling interval: on return, every position is exact at
 //! `world.time`.
@@ -30,6 +34,7 @@
 //! (contacts in its remainder are missed, so overlaps may then appear), and
 //! the schedule is rebuilt for the next step.
 pub mod body;
+pub mod cells;
 pub mod lattice;
 pub mod neighbours;
 pub mod queue;
@@ -41,10 +46,11 @@ use super::flight::fly;
 use super::model::{Model, ModelKind};
 use super::world::{Counters, World};
 use body::Body;
+use cells::Cells;
 use glam::DVec3;
 use neighbours::Neighbours;
 use queue::EventQueue;
-use schedule::{Event, Kind, predict};
+use schedule::{Event, Kind, Predictor};
 
 /// Events (contacts, wall hits, relists, stale predictions) a step may take,
 /// at least; scenes add [`EVENT_CAP_PER_SPHERE`] per sphere.
@@ -53,6 +59,27 @@ pub const EVENT_CAP_PER_SPHERE: u64 = 100;
 /// Internal times are kept relative to an origin that moves with the frames,
 /// so lazy positions `x + v (t - t_i)` never subtract large times.
 const ORIGIN_SPAN: f64 = 1.0;
+
+/// Above this packing fraction the broad phase is neighbour lists (a
+/// sphere's free path is short, so it meets its skin's edge rarely and
+/// checks fewer partners than 27 cells hold); below it, cells with crossing
+/// events (a free path is long, and crossing a cell is cheaper than
+/// rebuilding a list). Measured at N = 4000.
+pub const LISTS_ABOVE_PACKING: f64 = 0.3;
+
+/// Which broad phase the schedule uses; chosen from the packing fraction at
+/// each rebuild.
+#[derive(Clone, Debug)]
+enum Broad {
+    Lists(Neighbours),
+    Cells(Cells),
+}
+
+impl Default for Broad {
+    fn default() -> Self {
+        Broad::Cells(Cells::default())
+    }
+}
 
 /// A sphere–sphere contact, for observers (pressure virial, collision maps).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -77,7 +104,7 @@ pub struct Exact {
     counts: Vec<u32>,
     events: Vec<Event>,
     queue: EventQueue,
-    neighbours: Neighbours,
+    broad: Broad,
     size: f64,
     /// Absolute time of internal time zero.
     origin: f64,
@@ -98,6 +125,7 @@ pub struct EventStats {
     pub stale: u64,
     pub walls: u64,
     pub relists: u64,
+    pub crossings: u64,
     /// Full rebuilds of the schedule (start, outside changes, capped steps).
     pub rebuilds: u64,
 }
@@ -157,7 +185,20 @@ impl Exact {
         self.counts.resize(n, 0);
         self.events.clear();
         self.events.resize(n, Event::default());
-        self.neighbours.build(&self.bodies, self.size);
+        let filled: f64 = self
+            .bodies
+            .iter()
+            .map(|b| crate::physics::sphere::volume(b.radius))
+            .sum();
+        if filled > LISTS_ABOVE_PACKING * self.size.powi(3) {
+            let mut nl = Neighbours::default();
+            nl.build(&self.bodies, self.size);
+            self.broad = Broad::Lists(nl);
+        } else {
+            let mut cells = Cells::default();
+            cells.build(&self.bodies, self.size);
+            self.broad = Broad::Cells(cells);
+        }
         self.queue.reset(n);
         for i in 0..n {
             let (t, ev) = self.predict(i);
@@ -171,15 +212,26 @@ impl Exact {
     #[inline]
     fn predict(&self, i: usize) -> (f64, Event) {
         let a = &self.bodies[i];
-        let relist = self.neighbours.relist_time(i, a);
-        predict(
-            a,
-            self.neighbours.of(i),
-            &self.bodies,
-            &self.counts,
-            self.size,
-            relist,
-        )
+        match &self.broad {
+            Broad::Lists(nl) => {
+                let relist = Event {
+                    kind: Kind::Relist,
+                    ..Event::default()
+                };
+                let t = nl.relist_time(i, a);
+                let mut p = Predictor::new(a, &self.bodies, &self.counts, self.size, t, relist);
+                for l in nl.of(i) {
+                    p.pair(l.j);
+                }
+                p.finish()
+            }
+            Broad::Cells(cells) => {
+                let (t, ev) = cells.next_event(i, a);
+                let mut p = Predictor::new(a, &self.bodies, &self.counts, self.size, t, ev);
+                cells.for_each_candidate(i, a, |j| p.pair(j));
+                p.finish()
+            }
+        }
     }
 
     #[inline]
@@ -258,7 +310,17 @@ impl Exact {
                 }
                 Kind::Relist => {
                     self.stats.relists += 1;
-                    self.neighbours.rebuild(i, &self.bodies);
+                    match &mut self.broad {
+                        Broad::Lists(nl) => nl.rebuild(i, &self.bodies),
+                        Broad::Cells(cells) => cells.rescan(i, &self.bodies[i]),
+                    }
+                    self.schedule(i);
+                }
+                Kind::Cross => {
+                    self.stats.crossings += 1;
+                    if let Broad::Cells(cells) = &mut self.broad {
+                        cells.cross(i, ev.mask);
+                    }
                     self.schedule(i);
                 }
                 Kind::Idle => unreachable!("idle spheres have no finite event time"),
