@@ -103,6 +103,9 @@ pub struct Exact {
     mass: Vec<f64>,
     counts: Vec<u32>,
     events: Vec<Event>,
+    /// Cell mode: each sphere's best contact or wall event (absolute time),
+    /// kept apart from its crossing so a crossing rescans only new cells.
+    pending: Vec<(f64, Event)>,
     queue: EventQueue,
     broad: Broad,
     size: f64,
@@ -185,6 +188,8 @@ impl Exact {
         self.counts.resize(n, 0);
         self.events.clear();
         self.events.resize(n, Event::default());
+        self.pending.clear();
+        self.pending.resize(n, (f64::INFINITY, Event::default()));
         let filled: f64 = self
             .bodies
             .iter()
@@ -209,8 +214,10 @@ impl Exact {
         self.valid = true;
     }
 
+    /// Sphere `i`'s next event (absolute time); in cell mode also records
+    /// its best non-crossing event in `pending`.
     #[inline]
-    fn predict(&self, i: usize) -> (f64, Event) {
+    fn predict(&mut self, i: usize) -> (f64, Event) {
         let a = &self.bodies[i];
         match &self.broad {
             Broad::Lists(nl) => {
@@ -226,17 +233,54 @@ impl Exact {
                 p.finish()
             }
             Broad::Cells(cells) => {
-                let (t, ev) = cells.next_event(i, a);
-                let mut p = Predictor::new(a, &self.bodies, &self.counts, self.size, t, ev);
+                let idle = Event::default();
+                let mut p =
+                    Predictor::new(a, &self.bodies, &self.counts, self.size, f64::INFINITY, idle);
                 cells.for_each_candidate(i, a, |j| p.pair(j));
-                p.finish()
+                self.pending[i] = p.finish();
+                self.with_crossing(i)
             }
         }
+    }
+
+    /// Cell mode: the earlier of the pending event and the next crossing
+    /// (the crossing first on a tie).
+    #[inline]
+    fn with_crossing(&self, i: usize) -> (f64, Event) {
+        let Broad::Cells(cells) = &self.broad else {
+            unreachable!("crossings only in cell mode")
+        };
+        let a = &self.bodies[i];
+        let (tc, ev) = cells.next_event(i, a);
+        let tc = a.t + tc;
+        let (tp, evp) = self.pending[i];
+        if tc <= tp { (tc, ev) } else { (tp, evp) }
     }
 
     #[inline]
     fn schedule(&mut self, i: usize) {
         let (t, ev) = self.predict(i);
+        self.events[i] = ev;
+        self.queue.update(i, t);
+    }
+
+    /// Cell mode, after sphere `i` crossed as `mask` says: its pending event
+    /// still holds unless its partner has moved on; only the new layer of
+    /// cells needs checking.
+    fn after_crossing(&mut self, i: usize, mask: u8) {
+        let (tp, evp) = self.pending[i];
+        if evp.kind == Kind::Pair && self.counts[evp.partner as usize] != evp.partner_count {
+            self.schedule(i);
+            return;
+        }
+        let Broad::Cells(cells) = &self.broad else {
+            unreachable!("crossings only in cell mode")
+        };
+        let a = &self.bodies[i];
+        let mut p = Predictor::new(a, &self.bodies, &self.counts, self.size, tp - a.t, evp);
+        cells.for_each_new_candidate(i, mask, |j| p.pair(j));
+        self.pending[i] = p.finish();
+        let (t, ev) = self.with_crossing(i);
         self.events[i] = ev;
         self.queue.update(i, t);
     }
@@ -252,6 +296,9 @@ impl Exact {
             b.t = 0.0;
         }
         self.queue.shift(now);
+        for p in &mut self.pending {
+            p.0 -= now;
+        }
         self.origin = world_time;
     }
 
@@ -321,7 +368,7 @@ impl Exact {
                     if let Broad::Cells(cells) = &mut self.broad {
                         cells.cross(i, ev.mask);
                     }
-                    self.schedule(i);
+                    self.after_crossing(i, ev.mask);
                 }
                 Kind::Idle => unreachable!("idle spheres have no finite event time"),
             }
