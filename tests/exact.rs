@@ -220,3 +220,34 @@ fn dilute_scene_uses_cell_crossings() {
     assert!(w.counters.sphere_collisions > 1000);
     check_invariants(&w, e0, 1e-12, 1e-10);
 }
+
+#[test]
+fn observer_and_results_use_world_indices() {
+    // Listed against the model's spatial order: world index 0 is the high one.
+    use std::sync::{Arc, Mutex};
+    let mut w = World::new(
+        1.0,
+        vec![
+            sphere([0.5, 0.5, 0.8], [0.0, 0.0, -1.0], 0.1),
+            sphere([0.5, 0.5, 0.2], [0.0, 0.0, 1.0], 0.1),
+            sphere([0.1, 0.1, 0.1], [0.0; 3], 0.05),
+        ],
+    );
+    let seen = Arc::new(Mutex::new(Vec::new()));
+    let s2 = seen.clone();
+    let mut m = Exact::default();
+    m.set_observer(Some(Box::new(move |c| {
+        s2.lock()
+            .unwrap()
+            .push((c.i.min(c.j), c.i.max(c.j), c.pos_i.z.max(c.pos_j.z)))
+    })));
+    m.advance(&mut w, 0.25, 1, &Serial);
+    let seen = seen.lock().unwrap();
+    assert_eq!(seen.len(), 1);
+    assert_eq!((seen[0].0, seen[0].1), (0, 1));
+    assert!((seen[0].2 - 0.6).abs() < 1e-15);
+    // After the bounce at t = 0.2 each has gone back 0.05.
+    assert!((w.spheres[0].pos.z - 0.65).abs() < 1e-15);
+    assert!((w.spheres[1].pos.z - 0.35).abs() < 1e-15);
+    assert_eq!(w.spheres[2].pos, DVec3::splat(0.1));
+}

@@ -15,10 +15,12 @@
 //!
 //! Time of impact comes from [`pair_toi`](crate::physics::contact::pair_toi)
 //! (stable quadratic, rounding guard: overlapping and approaching collides
-//! now, receding is left alone). Simultaneous events are processed in sphere
-//! index order: the sphere whose prediction it is, lower index first; a
-//! sphere's own candidates tie its broad-phase event (relist or crossing),
-//! then walls, then partners in the order the broad phase offers them.
+//! now, receding is left alone). Simultaneous events are processed in a
+//! fixed order: by the sphere whose prediction it is, in the model's
+//! internal order (spatially sorted when the schedule is built, a pure
+//! function of the world); a sphere's own candidates tie its broad-phase
+//! event (relist or crossing) first, then walls, then partners in the order
+//! the broad phase offers them.
 //! Runs are therefore reproducible, and the event loop runs on one thread
 //! whatever the executor.
 //!
@@ -101,6 +103,10 @@ pub type Observer = Box<dyn FnMut(&Contact) + Send>;
 pub struct Exact {
     bodies: Vec<Body>,
     mass: Vec<f64>,
+    /// World index of each body: bodies are kept in a spatial order (sorted
+    /// by cell when loaded), so neighbours sit close in memory and a
+    /// prediction touches few cache lines.
+    order: Vec<u32>,
     counts: Vec<u32>,
     events: Vec<Event>,
     /// Cell mode: each sphere's best contact or wall event (absolute time),
@@ -157,12 +163,13 @@ impl Exact {
             && world.size == self.size
             && world.time == self.synced_time
             && world.spheres.len() == self.bodies.len()
-            && world
-                .spheres
+            && self
+                .order
                 .iter()
                 .zip(&self.bodies)
                 .zip(&self.mass)
-                .all(|((s, b), &m)| {
+                .all(|((&k, b), &m)| {
+                    let s = &world.spheres[k as usize];
                     s.pos == b.pos && s.vel == b.vel && s.radius == b.radius && s.mass == m
                 })
     }
@@ -171,11 +178,24 @@ impl Exact {
         self.size = world.size;
         self.origin = world.time;
         self.synced_time = world.time;
+        let n = world.spheres.len();
+        let side = ((n as f64).cbrt().ceil() as usize).max(1);
+        let cell = |x: f64| ((x / world.size * side as f64) as usize).min(side - 1);
+        let key =
+            |p: DVec3| cell(p.x.max(0.0)) + side * (cell(p.y.max(0.0)) + side * cell(p.z.max(0.0)));
+        self.order.clear();
+        self.order.extend(0..n as u32);
+        self.order
+            .sort_by_key(|&k| key(world.spheres[k as usize].pos));
         self.bodies.clear();
-        self.bodies
-            .extend(world.spheres.iter().map(|s| Body::from_sphere(s, 0.0)));
+        self.bodies.extend(
+            self.order
+                .iter()
+                .map(|&k| Body::from_sphere(&world.spheres[k as usize], 0.0)),
+        );
         self.mass.clear();
-        self.mass.extend(world.spheres.iter().map(|s| s.mass));
+        self.mass
+            .extend(self.order.iter().map(|&k| world.spheres[k as usize].mass));
         self.reschedule_all();
     }
 
@@ -234,8 +254,14 @@ impl Exact {
             }
             Broad::Cells(cells) => {
                 let idle = Event::default();
-                let mut p =
-                    Predictor::new(a, &self.bodies, &self.counts, self.size, f64::INFINITY, idle);
+                let mut p = Predictor::new(
+                    a,
+                    &self.bodies,
+                    &self.counts,
+                    self.size,
+                    f64::INFINITY,
+                    idle,
+                );
                 cells.for_each_candidate(i, a, |j| p.pair(j));
                 self.pending[i] = p.finish();
                 self.with_crossing(i)
@@ -384,8 +410,8 @@ impl Exact {
             if let Some(f) = &mut self.observer {
                 f(&Contact {
                     time: self.origin + self.bodies[i].t,
-                    i,
-                    j,
+                    i: self.order[i] as usize,
+                    j: self.order[j] as usize,
                     pos_i: a.pos,
                     pos_j: b.pos,
                     impulse: a.mass * (a.vel - before).length(),
@@ -411,8 +437,9 @@ impl Exact {
 
     fn write_back(&mut self, world: &mut World) {
         let now = world.time - self.origin;
-        for (s, b) in world.spheres.iter_mut().zip(&mut self.bodies) {
+        for (&k, b) in self.order.iter().zip(&mut self.bodies) {
             b.advance(now);
+            let s = &mut world.spheres[k as usize];
             s.pos = b.pos;
             s.vel = b.vel;
         }
