@@ -9,3 +9,4 @@ pub mod error;
 pub mod physics;
 pub mod scene;
 pub mod tradeoff;
+pub mod tui;

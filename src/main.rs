@@ -40,13 +40,15 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         None => {
             let settings = cli.run.settings()?;
             let world = scene::build_world(&cli.scene.spec())?;
-            println!(
-                "ballpit: {} spheres, model {}, threading {}. The terminal app is not built yet; try `ballpit bench --steps 600`.",
-                world.spheres.len(),
-                settings.model,
-                settings.threading
-            );
-            Ok(())
+            let color = match cli.color.as_deref() {
+                None => ballpit::tui::ColorChoice::Auto,
+                Some(c) => c.parse().map_err(BadInput)?,
+            };
+            let opts = ballpit::tui::Options {
+                fps: cli.fps,
+                color,
+            };
+            ballpit::tui::run(world, settings, opts)
         }
     }
 }

@@ -20,7 +20,7 @@ proptest! {
             .map(|&((x, y, z), r)| Sphere::new(DVec3::new(x, y, z), DVec3::ZERO, r))
             .collect();
         let mut grid = Grid::default();
-        grid.build(&spheres, 1.0, |s| (s.pos, s.radius));
+        grid.build(&spheres, 1.0, |s| (s.pos, s.radius), &Serial);
         let mut out = Vec::new();
         grid.pairs(&Serial, &|_: u32, _: u32| true, &mut out);
         let found: BTreeSet<(u32, u32)> = out.iter().map(|&(i, j)| (i.min(j), i.max(j))).collect();

@@ -1,273 +1,188 @@
-//! Broad phase: which pairs can touch within a step. A uniform grid whose cell
-//! is sized for the bulk of the spheres; the few that are much larger (or much
-//! faster) than the bulk live on a second level and query the grid over their
-//! own reach, so radii spread over orders of magnitude stay cheap. Tiny scenes
-//! use all pairs.
+//! Broad phase: which pairs can touch within a step. A hierarchy of uniform
+//! grids: the first level's cell is sized for the bulk of the spheres (the
+//! 98th percentile of their reach); the ones that do not fit go up to a
+//! coarser level sized the same way among themselves, and so on, and the last
+//! handful are tested against everything. A sphere of a coarse level meets
+//! the finer levels by querying their cells over its own reach, so radii or
+//! speeds spread over orders of magnitude stay about linear in cost. Tiny
+//! scenes use all pairs.
 use super::exec::{Exec, for_each_block};
 use super::sphere::Sphere;
 use glam::DVec3;
 use parking_lot::Mutex;
 
-/// Below this many spheres, all pairs beat building a grid.
+/// At most this many spheres are tested against everything.
 const ALL_PAIRS_MAX: usize = 24;
-/// Grid rows (cells along x at one y, z) per parallel block; fixed so results
-/// never depend on the thread count.
-const ROW_BLOCK: usize = 8;
-const BIG_BLOCK: usize = 16;
+/// Cell keys per parallel block; fixed so results never depend on the
+/// thread count.
+const KEY_BLOCK: usize = 2048;
+/// Coarse-level spheres per parallel block of cross-level queries.
+const CROSS_BLOCK: usize = 64;
+/// Spheres per parallel block while binning.
+const BUILD_BLOCK: usize = 4096;
 
 #[derive(Clone, Copy, Debug, Default)]
 struct Entry {
     pos: DVec3,
     reach: f64,
     id: u32,
-    /// Cell column along x: rows are swept in x order.
-    x: u32,
+    /// Padded cell key (see `Level::side`).
+    key: u32,
 }
 
 /// A pair that may touch: sphere indices, `i < j` not implied.
 pub type Pair = (u32, u32);
 
+/// One uniform grid. It is padded with one empty layer of cells on every
+/// side, so the neighbour cells of any real cell exist and need no bounds
+/// checks: the 13 forward neighbours of cell `c` are 5 contiguous key ranges
+/// at fixed offsets from `c`.
 #[derive(Default)]
-pub struct Grid {
-    dims: [usize; 3],
+struct Level {
+    /// Real cells per side.
+    per_side: usize,
+    /// Padded cells per side (`per_side + 2`).
+    side: usize,
     inv_cell: f64,
     cell: f64,
     cell_start: Vec<u32>,
+    /// Spheres of this level, sorted by cell key.
     entries: Vec<Entry>,
-    keys: Vec<u32>,
-    big: Vec<Entry>,
-    small_reach_max: f64,
-    all_pairs: bool,
-    scratch: Vec<f64>,
-    balls: Vec<(DVec3, f64)>,
-    fill: Vec<u32>,
-    cell_slots: Vec<Mutex<Vec<Pair>>>,
-    big_slots: Vec<Mutex<Vec<Pair>>>,
+    /// Largest reach in this level.
+    reach_max: f64,
 }
 
-impl Grid {
-    /// Bin the spheres. `ball(s)` is a centre and a reach: during the step
-    /// the sphere stays inside that ball, so a pair matters only when the
-    /// distance of the centres is at most the sum of the reaches.
-    pub fn build(&mut self, spheres: &[Sphere], size: f64, ball: impl Fn(&Sphere) -> (DVec3, f64)) {
-        let n = spheres.len();
-        self.entries.clear();
-        self.big.clear();
-        self.balls.clear();
-        self.balls.extend(spheres.iter().map(ball));
-        self.all_pairs = n <= ALL_PAIRS_MAX;
-        if self.all_pairs {
-            self.big.extend(
-                self.balls
-                    .iter()
-                    .enumerate()
-                    .map(|(i, &(pos, reach))| Entry {
-                        pos,
-                        reach,
-                        id: i as u32,
-                        x: 0,
-                    }),
-            );
-            return;
-        }
-        // Cell from the 98th percentile of reach (estimated on every 8th
-        // sphere: a function of the state only, so the grid, and the order
-        // pairs come out in, never depend on history): the bulk share few
-        // cells, the outliers go to the second level.
-        self.scratch.clear();
-        self.scratch
-            .extend(self.balls.iter().step_by(8).map(|b| b.1));
-        let max_reach = self.balls.iter().fold(0.0f64, |m, b| m.max(b.1));
-        let k = (self.scratch.len() * 98 / 100).min(self.scratch.len() - 1);
-        let q = *self
-            .scratch
-            .select_nth_unstable_by(k, |a, b| a.total_cmp(b))
-            .1;
-        let small_max = if max_reach <= 3.0 * q { max_reach } else { q };
-        let want = (2.0 * small_max).max(f64::MIN_POSITIVE);
-        // At most ~2 cells per sphere and 1024 per side keeps memory O(N).
-        let cap = ((2 * n) as f64).cbrt().ceil().clamp(1.0, 1024.0);
-        let per_side = (size / want).floor().clamp(1.0, cap) as usize;
-        self.dims = [per_side; 3];
-        self.cell = size / per_side as f64;
+#[derive(Default)]
+pub struct Grid {
+    levels: Vec<Level>,
+    /// The last few, tested against everything.
+    top: Vec<Entry>,
+    balls: Vec<(DVec3, f64)>,
+    keys: Vec<u32>,
+    /// Spheres not yet placed in a level: (ball, id).
+    rest: Vec<(DVec3, f64, u32)>,
+    scratch: Vec<f64>,
+    fill: Vec<u32>,
+    slots: Vec<Mutex<Vec<Pair>>>,
+}
+
+/// Real cell coordinates of `p`, clamped into `0..=last`. Truncation is
+/// floor here (after max(0)), without a libm call.
+#[inline]
+fn cell_coords(p: DVec3, inv_cell: f64, last: usize) -> [usize; 3] {
+    let c = |x: f64| ((x * inv_cell).max(0.0) as usize).min(last);
+    [c(p.x), c(p.y), c(p.z)]
+}
+
+/// The 98th percentile of `reach` (estimated on every `stride`-th value: a
+/// function of the state only, so the grid, and the order pairs come out
+/// in, never depend on history) and the maximum.
+fn cell_for(
+    reaches: impl Iterator<Item = f64> + Clone,
+    stride: usize,
+    scratch: &mut Vec<f64>,
+) -> f64 {
+    scratch.clear();
+    scratch.extend(reaches.clone().step_by(stride));
+    let max = reaches.fold(0.0f64, f64::max);
+    if scratch.is_empty() {
+        return 2.0 * max;
+    }
+    let k = (scratch.len() * 98 / 100).min(scratch.len() - 1);
+    let q = *scratch.select_nth_unstable_by(k, |a, b| a.total_cmp(b)).1;
+    // When the fastest is close to the bulk, one level holds everyone.
+    2.0 * if max <= 1.25 * q { max } else { q }
+}
+
+impl Level {
+    fn shape(&mut self, size: f64, want: f64, n: usize) {
+        // At most ~8 cells per sphere (empty cells cost nothing to skip)
+        // and 1024 per side keep memory O(N).
+        let cap = ((8 * n.max(1)) as f64).cbrt().ceil().clamp(1.0, 1024.0);
+        self.per_side = (size / want.max(f64::MIN_POSITIVE)).floor().clamp(1.0, cap) as usize;
+        self.side = self.per_side + 2;
+        self.cell = size / self.per_side as f64;
         self.inv_cell = 1.0 / self.cell;
-        self.small_reach_max = 0.0;
-        let cells = per_side * per_side * per_side;
+        self.reach_max = 0.0;
         self.cell_start.clear();
-        self.cell_start.resize(cells + 1, 0);
-        self.keys.clear();
-        for (i, &(pos, r)) in self.balls.iter().enumerate() {
-            if 2.0 * r <= self.cell {
-                let key = self.cell_of(pos);
-                self.small_reach_max = self.small_reach_max.max(r);
-                self.cell_start[key + 1] += 1;
-                self.keys.push(key as u32);
-            } else {
-                self.keys.push(u32::MAX);
-                self.big.push(Entry {
-                    pos,
-                    reach: r,
-                    id: i as u32,
-                    x: 0,
-                });
-            }
+        self.cell_start
+            .resize(self.side * self.side * self.side + 1, 0);
+        self.entries.clear();
+    }
+
+    #[inline]
+    fn fits(&self, reach: f64) -> bool {
+        2.0 * reach <= self.cell
+    }
+
+    #[inline]
+    fn key_of(&self, p: DVec3) -> u32 {
+        let [x, y, z] = cell_coords(p, self.inv_cell, self.per_side - 1);
+        ((x + 1) + self.side * ((y + 1) + self.side * (z + 1))) as u32
+    }
+
+    /// Counting sort of `items` (ball, id, key), stable.
+    fn fill(&mut self, items: impl Iterator<Item = Entry> + Clone, fill: &mut Vec<u32>) {
+        for e in items.clone() {
+            self.reach_max = self.reach_max.max(e.reach);
+            self.cell_start[e.key as usize + 1] += 1;
         }
+        let cells = self.cell_start.len() - 1;
         for c in 0..cells {
             self.cell_start[c + 1] += self.cell_start[c];
         }
-        let small = self.cell_start[cells] as usize;
-        self.entries.resize(small, Entry::default());
-        // Counting sort, stable: spheres of a cell keep index order.
-        self.fill.clear();
-        self.fill.extend_from_slice(&self.cell_start[..cells]);
-        let nx = self.dims[0] as u32;
-        for (i, (&key, &(pos, reach))) in self.keys.iter().zip(&self.balls).enumerate() {
-            if key != u32::MAX {
-                let slot = &mut self.fill[key as usize];
-                self.entries[*slot as usize] = Entry {
-                    pos,
-                    reach,
-                    id: i as u32,
-                    x: key % nx,
-                };
-                *slot += 1;
-            }
+        self.entries
+            .resize(self.cell_start[cells] as usize, Entry::default());
+        fill.clear();
+        fill.extend_from_slice(&self.cell_start[..cells]);
+        for e in items {
+            let slot = &mut fill[e.key as usize];
+            self.entries[*slot as usize] = e;
+            *slot += 1;
         }
     }
 
-    fn cell_of(&self, p: DVec3) -> usize {
-        let [nx, ny, nz] = self.dims;
-        let c = |x: f64, n: usize| ((x * self.inv_cell) as isize).clamp(0, n as isize - 1) as usize;
-        c(p.x, nx) + nx * (c(p.y, ny) + ny * c(p.z, nz))
+    fn key_blocks(&self) -> usize {
+        (self.cell_start.len() - 1).div_ceil(KEY_BLOCK)
     }
 
-    /// Every pair within reach, in a fixed order (cell blocks, then the
-    /// second level), found in parallel on `exec`; `keep` filters pairs.
-    pub fn pairs<K: Fn(u32, u32) -> bool + Sync>(
-        &mut self,
-        exec: &dyn Exec,
-        keep: &K,
-        out: &mut Vec<Pair>,
-    ) {
-        out.clear();
-        let rows = self.dims[1] * self.dims[2];
-        let cell_blocks = if self.all_pairs {
-            0
-        } else {
-            rows.div_ceil(ROW_BLOCK)
-        };
-        let big_blocks = self.big.len().div_ceil(BIG_BLOCK);
-        ensure_slots(&mut self.cell_slots, cell_blocks);
-        ensure_slots(&mut self.big_slots, big_blocks);
-        let this = &*self;
-        let total = cell_blocks + big_blocks;
-        for_each_block(exec, total, &|b| {
-            if b < cell_blocks {
-                let mut v = this.cell_slots[b].lock();
-                v.clear();
-                let end = ((b + 1) * ROW_BLOCK).min(rows);
-                for r in b * ROW_BLOCK..end {
-                    this.row_pairs(r, &mut |i, j| {
-                        if keep(i, j) {
-                            v.push((i, j))
-                        }
-                    });
-                }
-            } else {
-                let b = b - cell_blocks;
-                let mut v = this.big_slots[b].lock();
-                v.clear();
-                let end = ((b + 1) * BIG_BLOCK).min(this.big.len());
-                for k in b * BIG_BLOCK..end {
-                    this.big_pairs(k, &mut |i, j| {
-                        if keep(i, j) {
-                            v.push((i, j))
-                        }
-                    });
-                }
-            }
-        });
-        for s in &self.cell_slots[..cell_blocks] {
-            out.extend_from_slice(&s.lock());
-        }
-        for s in &self.big_slots[..big_blocks] {
-            out.extend_from_slice(&s.lock());
-        }
-    }
-
-    /// Entries of the cells `x0..=x1` of row `(y, z)`: contiguous, since
-    /// keys run along x.
+    /// Entries of the cells with keys `k0..k1`: contiguous, keys being sorted.
     #[inline]
-    fn row(&self, x0: usize, x1: usize, y: usize, z: usize) -> &[Entry] {
-        let [nx, ny, _] = self.dims;
-        let base = nx * (y + ny * z);
-        &self.entries[self.cell_start[base + x0] as usize..self.cell_start[base + x1 + 1] as usize]
+    fn keys_range(&self, k0: usize, k1: usize) -> &[Entry] {
+        &self.entries[self.cell_start[k0] as usize..self.cell_start[k1] as usize]
     }
 
-    /// Entries of row `r` (= y + ny z), in x order.
-    #[inline]
-    fn row_entries(&self, r: usize) -> &[Entry] {
-        let nx = self.dims[0];
-        &self.entries[self.cell_start[r * nx] as usize..self.cell_start[(r + 1) * nx] as usize]
-    }
-
-    /// Pairs with at least one sphere in row `r`, each found once: each
-    /// sphere against the rest of its cell and the next cell along x, and
-    /// the cells x-1..=x+1 of the four forward rows (13 cells in all).
-    /// Each neighbour window is a pair of cursors that only move forward as
-    /// the sweep moves along x, so empty cells cost nothing.
-    fn row_pairs(&self, r: usize, f: &mut impl FnMut(u32, u32)) {
-        let here = self.row_entries(r);
-        if here.is_empty() {
-            return;
-        }
-        let [_, ny, nz] = self.dims;
-        let (y, z) = (r % ny, r / ny);
-        let mut others: [&[Entry]; 4] = [&[]; 4];
-        let mut count = 0;
-        if y + 1 < ny {
-            others[count] = self.row_entries(r + 1);
-            count += 1;
-        }
-        if z + 1 < nz {
-            for yy in y.saturating_sub(1)..=(y + 1).min(ny - 1) {
-                others[count] = self.row_entries(yy + ny * (z + 1));
-                count += 1;
-            }
-        }
-        let others = &others[..count];
-        let mut lo = [0usize; 4];
-        let mut hi = [0usize; 4];
-        let mut same_hi = 0;
-        let mut k = 0;
-        // One cell at a time: its windows are found once for all its spheres.
-        while k < here.len() {
-            let x = here[k].x;
-            let mut end = k + 1;
-            while end < here.len() && here[end].x == x {
-                end += 1;
-            }
-            while same_hi < here.len() && here[same_hi].x <= x + 1 {
-                same_hi += 1;
-            }
-            let mut windows: [&[Entry]; 4] = [&[]; 4];
-            for (o, row) in others.iter().enumerate() {
-                while lo[o] < row.len() && row[lo[o]].x + 1 < x {
-                    lo[o] += 1;
+    /// Same-level pairs with a sphere in key block `b`, each found once: a
+    /// sphere against the rest of its cell and the next cell along x, and the
+    /// cells x-1..=x+1 of the four forward rows.
+    fn block_pairs(&self, b: usize, f: &mut impl FnMut(&Entry, &Entry)) {
+        let keys = self.cell_start.len() - 1;
+        let cs = &self.cell_start[..];
+        let e = &self.entries[..];
+        let s = self.side;
+        let mut k = cs[b * KEY_BLOCK] as usize;
+        let hi = cs[((b + 1) * KEY_BLOCK).min(keys)] as usize;
+        while k < hi {
+            let c = e[k].key as usize;
+            let end = cs[c + 1] as usize;
+            let row_end = cs[c + 2] as usize;
+            // Forward rows: (y+1, z), then (y-1..=y+1, z+1); x-1..=x+1 each.
+            let (r1, r2) = (c + s - 1, c + s * s - s - 1);
+            let (r3, r4) = (r2 + s, r2 + 2 * s);
+            let windows = [
+                &e[cs[r1] as usize..cs[r1 + 3] as usize],
+                &e[cs[r2] as usize..cs[r2 + 3] as usize],
+                &e[cs[r3] as usize..cs[r3 + 3] as usize],
+                &e[cs[r4] as usize..cs[r4 + 3] as usize],
+            ];
+            for i in k..end {
+                let a = &e[i];
+                for b in &e[i + 1..row_end] {
+                    f(a, b);
                 }
-                hi[o] = hi[o].max(lo[o]);
-                while hi[o] < row.len() && row[hi[o]].x <= x + 1 {
-                    hi[o] += 1;
-                }
-                windows[o] = &row[lo[o]..hi[o]];
-            }
-            for (j, a) in here[k..end].iter().enumerate() {
-                for b in &here[k + j + 1..same_hi] {
-                    test(a, b, f);
-                }
-                for w in &windows[..others.len()] {
-                    for b in *w {
-                        test(a, b, f);
+                for w in windows {
+                    for b in w {
+                        f(a, b);
                     }
                 }
             }
@@ -275,77 +190,269 @@ impl Grid {
         }
     }
 
-    /// Every sphere (either level) that may lie within `span` of `p`, as
-    /// `f(id, centre, reach)`: all of the second level, and the grid cells
-    /// that cover `p ± span`. The caller applies its own test.
-    pub fn near(&self, p: DVec3, span: f64, f: &mut impl FnMut(u32, DVec3, f64)) {
-        if !self.all_pairs && !self.entries.is_empty() {
-            let lo = self.cell_coords(p - DVec3::splat(span));
-            let hi = self.cell_coords(p + DVec3::splat(span));
-            for z in lo[2]..=hi[2] {
-                for y in lo[1]..=hi[1] {
-                    for b in self.row(lo[0], hi[0], y, z) {
-                        f(b.id, b.pos, b.reach);
-                    }
-                }
-            }
+    /// Entries in the cells covering `p ± span`.
+    fn near(&self, p: DVec3, span: f64, f: &mut impl FnMut(&Entry)) {
+        if self.entries.is_empty() {
+            return;
         }
-        for b in &self.big {
-            f(b.id, b.pos, b.reach);
-        }
-    }
-
-    /// Largest reach among first-level (grid) spheres.
-    pub fn small_reach(&self) -> f64 {
-        self.small_reach_max
-    }
-
-    fn grid_near(&self, a: &Entry, f: &mut impl FnMut(u32, u32)) {
-        let span = a.reach + self.small_reach_max;
-        let lo = self.cell_coords(a.pos - DVec3::splat(span));
-        let hi = self.cell_coords(a.pos + DVec3::splat(span));
+        let last = self.per_side - 1;
+        let lo = cell_coords(p - DVec3::splat(span), self.inv_cell, last);
+        let hi = cell_coords(p + DVec3::splat(span), self.inv_cell, last);
         for z in lo[2]..=hi[2] {
             for y in lo[1]..=hi[1] {
-                for b in self.row(lo[0], hi[0], y, z) {
-                    test(a, b, f);
+                let k = (lo[0] + 1) + self.side * ((y + 1) + self.side * (z + 1));
+                for b in self.keys_range(k, k + hi[0] - lo[0] + 1) {
+                    f(b);
                 }
             }
         }
-    }
-
-    /// Pairs of second-level sphere `k` with every grid sphere in its reach
-    /// and with the second-level spheres after it.
-    fn big_pairs(&self, k: usize, f: &mut impl FnMut(u32, u32)) {
-        let a = &self.big[k];
-        if !self.all_pairs && !self.entries.is_empty() {
-            self.grid_near(a, f);
-        }
-        for b in &self.big[k + 1..] {
-            test(a, b, f);
-        }
-    }
-
-    fn cell_coords(&self, p: DVec3) -> [usize; 3] {
-        let c = |x: f64, n: usize| ((x * self.inv_cell).floor().max(0.0) as usize).min(n - 1);
-        [
-            c(p.x, self.dims[0]),
-            c(p.y, self.dims[1]),
-            c(p.z, self.dims[2]),
-        ]
     }
 }
 
 #[inline(always)]
-fn test(a: &Entry, b: &Entry, f: &mut impl FnMut(u32, u32)) {
+fn within(a: &Entry, b: &Entry) -> bool {
     let s = a.reach + b.reach;
-    if (a.pos - b.pos).length_squared() <= s * s {
-        f(a.id, b.id);
-    }
+    (a.pos - b.pos).length_squared() <= s * s
 }
 
-fn ensure_slots<T>(slots: &mut Vec<Mutex<Vec<T>>>, n: usize) {
-    while slots.len() < n {
-        slots.push(Mutex::new(Vec::new()));
+/// The work units of `pairs`, in the fixed order their results are joined.
+#[derive(Clone, Copy)]
+enum Unit {
+    /// Same-level pairs of one key block of a level.
+    Block { level: usize, block: usize },
+    /// Spheres `from..to` of a coarse level against every finer level.
+    Cross {
+        level: usize,
+        from: usize,
+        to: usize,
+    },
+    /// The last few against everything.
+    Top,
+}
+
+impl Grid {
+    /// Bin the spheres. `ball(s)` is a centre and a reach: during the step
+    /// the sphere stays inside that ball, so a pair matters only when the
+    /// distance of the centres is at most the sum of the reaches. The
+    /// per-sphere arithmetic of the first level runs on `exec`.
+    pub fn build(
+        &mut self,
+        spheres: &[Sphere],
+        size: f64,
+        ball: impl Fn(&Sphere) -> (DVec3, f64) + Sync,
+        exec: &dyn Exec,
+    ) {
+        let n = spheres.len();
+        self.top.clear();
+        self.balls.resize(n, (DVec3::ZERO, 0.0));
+        {
+            let chunks: Vec<Mutex<&mut [(DVec3, f64)]>> =
+                self.balls.chunks_mut(BUILD_BLOCK).map(Mutex::new).collect();
+            for_each_block(exec, chunks.len(), &|b| {
+                let mut chunk = chunks[b].lock();
+                for (slot, s) in chunk.iter_mut().zip(&spheres[b * BUILD_BLOCK..]) {
+                    *slot = ball(s);
+                }
+            });
+        }
+        let mut depth = 0;
+        if n > ALL_PAIRS_MAX {
+            // First level: keys in parallel, the sort serial.
+            if self.levels.is_empty() {
+                self.levels.push(Level::default());
+            }
+            let want = cell_for(self.balls.iter().map(|b| b.1), 8, &mut self.scratch);
+            let level = &mut self.levels[0];
+            level.shape(size, want, n);
+            self.keys.resize(n, 0);
+            {
+                let level = &*level;
+                let balls = &self.balls;
+                let chunks: Vec<Mutex<&mut [u32]>> =
+                    self.keys.chunks_mut(BUILD_BLOCK).map(Mutex::new).collect();
+                for_each_block(exec, chunks.len(), &|b| {
+                    let mut chunk = chunks[b].lock();
+                    for (slot, &(pos, r)) in chunk.iter_mut().zip(&balls[b * BUILD_BLOCK..]) {
+                        *slot = if level.fits(r) {
+                            level.key_of(pos)
+                        } else {
+                            u32::MAX
+                        };
+                    }
+                });
+            }
+            let (keys, balls) = (&self.keys, &self.balls);
+            let placed = keys
+                .iter()
+                .zip(balls)
+                .enumerate()
+                .filter(|(_, (k, _))| **k != u32::MAX)
+                .map(|(i, (&key, &(pos, reach)))| Entry {
+                    pos,
+                    reach,
+                    id: i as u32,
+                    key,
+                });
+            level.fill(placed, &mut self.fill);
+            self.rest.clear();
+            self.rest.extend(
+                keys.iter()
+                    .zip(balls)
+                    .enumerate()
+                    .filter(|(_, (k, _))| **k == u32::MAX)
+                    .map(|(i, (_, &(p, r)))| (p, r, i as u32)),
+            );
+            depth = 1;
+            // Coarser levels for what did not fit, serially: they are few.
+            while self.rest.len() > ALL_PAIRS_MAX {
+                if self.levels.len() == depth {
+                    self.levels.push(Level::default());
+                }
+                let want = cell_for(self.rest.iter().map(|b| b.1), 1, &mut self.scratch);
+                let level = &mut self.levels[depth];
+                level.shape(size, want, self.rest.len());
+                let placed: Vec<Entry> = self
+                    .rest
+                    .iter()
+                    .filter(|b| level.fits(b.1))
+                    .map(|&(pos, reach, id)| Entry {
+                        pos,
+                        reach,
+                        id,
+                        key: level.key_of(pos),
+                    })
+                    .collect();
+                level.fill(placed.iter().copied(), &mut self.fill);
+                let cell = level.cell;
+                self.rest.retain(|b| 2.0 * b.1 > cell);
+                depth += 1;
+            }
+            self.top
+                .extend(self.rest.iter().map(|&(pos, reach, id)| Entry {
+                    pos,
+                    reach,
+                    id,
+                    key: 0,
+                }));
+        } else {
+            self.top.extend(
+                self.balls
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &(pos, reach))| Entry {
+                        pos,
+                        reach,
+                        id: i as u32,
+                        key: 0,
+                    }),
+            );
+        }
+        self.levels.truncate(depth);
+    }
+
+    fn units(&self) -> Vec<Unit> {
+        let mut units = Vec::new();
+        for (l, level) in self.levels.iter().enumerate() {
+            units.extend((0..level.key_blocks()).map(|block| Unit::Block { level: l, block }));
+            if l > 0 {
+                let n = level.entries.len();
+                units.extend((0..n.div_ceil(CROSS_BLOCK)).map(|b| Unit::Cross {
+                    level: l,
+                    from: b * CROSS_BLOCK,
+                    to: ((b + 1) * CROSS_BLOCK).min(n),
+                }));
+            }
+        }
+        if !self.top.is_empty() {
+            units.push(Unit::Top);
+        }
+        units
+    }
+
+    fn unit_pairs(&self, unit: Unit, f: &mut impl FnMut(&Entry, &Entry)) {
+        match unit {
+            Unit::Block { level, block } => self.levels[level].block_pairs(block, f),
+            Unit::Cross { level, from, to } => {
+                for a in &self.levels[level].entries[from..to] {
+                    for finer in &self.levels[..level] {
+                        finer.near(a.pos, a.reach + finer.reach_max, &mut |b| f(a, b));
+                    }
+                }
+            }
+            Unit::Top => {
+                for (k, a) in self.top.iter().enumerate() {
+                    for level in &self.levels {
+                        level.near(a.pos, a.reach + level.reach_max, &mut |b| f(a, b));
+                    }
+                    for b in &self.top[k + 1..] {
+                        f(a, b);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Every pair within reach, in a fixed order, found in parallel on
+    /// `exec`; `keep` filters pairs.
+    pub fn pairs<K: Fn(u32, u32) -> bool + Sync>(
+        &mut self,
+        exec: &dyn Exec,
+        keep: &K,
+        out: &mut Vec<Pair>,
+    ) {
+        out.clear();
+        let units = self.units();
+        while self.slots.len() < units.len() {
+            self.slots.push(Mutex::new(Vec::new()));
+        }
+        let this = &*self;
+        for_each_block(exec, units.len(), &|u| {
+            let mut v = this.slots[u].lock();
+            v.clear();
+            this.unit_pairs(units[u], &mut |a, b| {
+                if within(a, b) && keep(a.id, b.id) {
+                    v.push((a.id, b.id));
+                }
+            });
+        });
+        for s in &self.slots[..units.len()] {
+            out.extend_from_slice(&s.lock());
+        }
+    }
+
+    /// Every sphere whose ball may meet a ball of radius `reach` around `p`,
+    /// as `f(id, centre, reach)`, including spheres whose reach has since
+    /// grown up to [`Grid::growth_cap`]; the caller applies its own test.
+    pub fn near(&self, p: DVec3, reach: f64, f: &mut impl FnMut(u32, DVec3, f64)) {
+        for level in &self.levels {
+            level.near(p, reach + 2.0 * level.reach_max, &mut |b| {
+                f(b.id, b.pos, b.reach)
+            });
+        }
+        for b in &self.top {
+            f(b.id, b.pos, b.reach);
+        }
+    }
+
+    /// How far a sphere that started with reach `reach` may grow and still
+    /// be found by [`Grid::near`]; beyond it the caller must track it itself.
+    pub fn growth_cap(&self, reach: f64) -> f64 {
+        self.levels
+            .iter()
+            .find(|l| l.fits(reach))
+            .map_or(f64::INFINITY, |l| 2.0 * l.reach_max)
+    }
+
+    /// Cells per side of each level, and how many spheres each holds (the
+    /// last number: tested against everything). For diagnostics.
+    pub fn shape(&self) -> (Vec<(usize, usize)>, usize) {
+        (
+            self.levels
+                .iter()
+                .map(|l| (l.per_side, l.entries.len()))
+                .collect(),
+            self.top.len(),
+        )
     }
 }
 
@@ -353,7 +460,7 @@ fn ensure_slots<T>(slots: &mut Vec<Mutex<Vec<T>>>, n: usize) {
 /// (centres within the sum of radii). Serial; for checks and placement.
 pub fn for_each_near_pair(spheres: &[Sphere], size: f64, mut f: impl FnMut(usize, usize)) {
     let mut grid = Grid::default();
-    grid.build(spheres, size, |s| (s.pos, s.radius));
+    grid.build(spheres, size, |s| (s.pos, s.radius), &super::exec::Serial);
     let mut out = Vec::new();
     grid.pairs(&super::exec::Serial, &|_: u32, _: u32| true, &mut out);
     for (i, j) in out {

@@ -2,7 +2,8 @@
 //! with velocity impulses. Cheapest per step; spheres may overlap by up to
 //! about `dt·speed` and fast ones can pass through each other (tunnelling).
 //! Wall contacts mirror the position back inside (no energy is added: only
-//! velocities carry energy).
+//! velocities carry energy). Overlaps are found on the moved positions,
+//! before the wall mirror.
 use super::broad::{Grid, Pair};
 use super::contact::resolve_pair;
 use super::exec::{Exec, for_each_block};
@@ -16,7 +17,8 @@ use parking_lot::Mutex;
 pub struct Discrete {
     grid: Grid,
     pairs: Vec<Pair>,
-    block_walls: Vec<Mutex<(f64, u64)>>,
+    /// Per block, the spheres found past a wall.
+    walls: Vec<Mutex<Vec<u32>>>,
 }
 
 impl Model for Discrete {
@@ -35,9 +37,10 @@ impl Model for Discrete {
 impl Discrete {
     fn step(&mut self, world: &mut World, dt: f64, exec: &dyn Exec) {
         let size = world.size;
-        let blocks = world.spheres.len().div_ceil(SPHERE_BLOCK);
-        while self.block_walls.len() < blocks {
-            self.block_walls.push(Mutex::new((0.0, 0)));
+        let n = world.spheres.len();
+        let blocks = n.div_ceil(SPHERE_BLOCK);
+        while self.walls.len() < blocks {
+            self.walls.push(Mutex::new(Vec::new()));
         }
         {
             let chunks: Vec<Mutex<&mut [Sphere]>> = world
@@ -45,33 +48,59 @@ impl Discrete {
                 .chunks_mut(SPHERE_BLOCK)
                 .map(Mutex::new)
                 .collect();
-            let walls = &self.block_walls;
             for_each_block(exec, blocks, &|b| {
-                let mut tally = (0.0, 0u64);
                 for s in chunks[b].lock().iter_mut() {
                     s.pos += s.vel * dt;
-                    let (imp, hits) = bounce(s, size);
-                    tally.0 += imp;
-                    tally.1 += hits;
                 }
-                *walls[b].lock() = tally;
             });
         }
-        for w in &self.block_walls[..blocks] {
-            let (imp, hits) = *w.lock();
-            world.counters.wall_momentum += imp;
-            world.counters.wall_collisions += hits;
-        }
-        self.grid.build(&world.spheres, size, |s| (s.pos, s.radius));
         let sp = &world.spheres;
         let overlapping = |i: u32, j: u32| {
             let (a, b) = (&sp[i as usize], &sp[j as usize]);
             let s = a.radius + b.radius;
             a.pos.distance_squared(b.pos) < s * s
         };
-        self.grid.pairs(exec, &overlapping, &mut self.pairs);
-        // Resolution in a fixed order: a sphere in several pairs sees them
-        // one after another, whatever thread found them.
+        let walls = &self.walls;
+        let find_walls = |exec: &dyn Exec| {
+            for_each_block(exec, blocks, &|b| {
+                let mut v = walls[b].lock();
+                v.clear();
+                let end = ((b + 1) * SPHERE_BLOCK).min(n);
+                v.extend(
+                    (b * SPHERE_BLOCK..end)
+                        .filter(|&i| outside(&sp[i], size))
+                        .map(|i| i as u32),
+                );
+            })
+        };
+        if exec.functional() {
+            // Sphere–sphere work (which pairs overlap) beside sphere–wall
+            // work (which spheres are past a wall).
+            let serial = super::exec::Serial;
+            let detect = Mutex::new((&mut self.grid, &mut self.pairs));
+            exec.join(
+                &|| {
+                    let mut g = detect.lock();
+                    let (grid, pairs) = &mut *g;
+                    grid.build(sp, size, |s| (s.pos, s.radius), &serial);
+                    grid.pairs(&serial, &overlapping, pairs);
+                },
+                &|| find_walls(&serial),
+            );
+        } else {
+            self.grid.build(sp, size, |s| (s.pos, s.radius), exec);
+            self.grid.pairs(exec, &overlapping, &mut self.pairs);
+            find_walls(exec);
+        }
+        // Answers in a fixed order: walls, then pairs, whatever thread found
+        // them; a sphere in several pairs sees them one after another.
+        for w in &self.walls[..blocks] {
+            for &i in w.lock().iter() {
+                let (imp, hits) = bounce(&mut world.spheres[i as usize], size);
+                world.counters.wall_momentum += imp;
+                world.counters.wall_collisions += hits;
+            }
+        }
         for &(i, j) in &self.pairs {
             let (a, b) = pair_mut(&mut world.spheres, i as usize, j as usize);
             if resolve_pair(a, b) {
@@ -79,6 +108,10 @@ impl Discrete {
             }
         }
     }
+}
+
+fn outside(s: &Sphere, size: f64) -> bool {
+    s.pos.min_element() < s.radius || s.pos.max_element() > size - s.radius
 }
 
 /// A sphere past a wall and moving out is mirrored back in and reflected.

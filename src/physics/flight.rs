@@ -25,9 +25,12 @@ pub fn fly(s: &mut Sphere, size: f64, t: f64) -> (f64, u64) {
         if w <= 0.0 {
             continue;
         }
-        let segs = (u1 / w).floor();
+        // u1 >= 0, so truncation is floor; segments beyond 2^53 lose
+        // their parity, and a sphere that fast has no meaningful position.
+        let whole = (u1 / w) as u64;
+        let segs = whole as f64;
         let f = (u1 - segs * w).clamp(0.0, w);
-        let odd = segs % 2.0 != 0.0;
+        let odd = whole & 1 == 1;
         let (xm, vm) = if odd {
             (lo + w - f, -speed)
         } else {

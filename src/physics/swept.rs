@@ -39,6 +39,8 @@ pub struct Swept {
     /// Each sphere's ball for the step: it stays within `reach` of `centre`.
     centre: Vec<DVec3>,
     reach: Vec<f64>,
+    /// How far each reach may grow before the grid can no longer find it.
+    cap: Vec<f64>,
     grown: Vec<u32>,
     heap: BinaryHeap<Event>,
     found: Vec<u32>,
@@ -103,7 +105,8 @@ impl Swept {
     fn step(&mut self, world: &mut World, dt: f64, exec: &dyn Exec) {
         let size = world.size;
         let n = world.spheres.len();
-        self.grid.build(&world.spheres, size, |s| path_ball(s, dt));
+        self.grid
+            .build(&world.spheres, size, |s| path_ball(s, dt), exec);
         let blocks = n.div_ceil(SPHERE_BLOCK);
         while self.wall_slots.len() < blocks {
             self.wall_slots.push(Mutex::new(Vec::new()));
@@ -173,6 +176,7 @@ impl Swept {
         let (centre, reach) = path_ball(s, dt);
         self.centre.push(centre);
         self.reach.push(reach);
+        self.cap.push(self.grid.growth_cap(reach));
         push_wall(&mut self.heap, s, l, 0.0, 0, size, dt);
         l
     }
@@ -190,6 +194,7 @@ impl Swept {
         self.count.clear();
         self.centre.clear();
         self.reach.clear();
+        self.cap.clear();
         self.grown.clear();
         self.heap.clear();
         let size = world.size;
@@ -261,11 +266,10 @@ impl Swept {
         let sa = sp[ia];
         let need = ((sa.pos - self.centre[la]).length() + sa.vel.length() * (dt - t) + sa.radius)
             * REACH_SLACK;
-        // Grid spheres may grow up to `small` and still be found through the
-        // cells; beyond that they join `grown`, which every rescan checks.
-        let small = 2.0 * self.grid.small_reach();
+        // A sphere may grow up to its cap and still be found through the
+        // grid; beyond that it joins `grown`, which every rescan checks.
         if need > self.reach[la] {
-            if need > small && self.reach[la] <= small {
+            if need > self.cap[la] && self.reach[la] <= self.cap[la] {
                 self.grown.push(a);
             }
             self.reach[la] = need;
@@ -286,7 +290,7 @@ impl Swept {
                 found.push(j);
             }
         };
-        self.grid.near(p0, ra + small, &mut consider);
+        self.grid.near(p0, ra, &mut consider);
         for &g in &self.grown {
             let lg = g as usize;
             consider(self.involved[lg], self.centre[lg], self.reach[lg]);

@@ -1,0 +1,39 @@
+//! The terminal app. It only reads engine snapshots and sends commands.
+//!
+//! One thread (the caller's) runs the frame loop: start the engine's next
+//! frame, draw the previous snapshot while it computes, finish the frame.
+//! Keys, resizes and signals arrive over a channel from the named threads
+//! `input` and `signals`, so the loop sleeps until a frame is due or
+//! something happens, and never busy-waits.
+pub mod app;
+pub mod canvas;
+pub mod guard;
+pub mod help;
+pub mod input;
+pub mod output;
+pub mod projection;
+pub mod readouts;
+pub mod run;
+pub mod state;
+pub mod theme;
+pub mod threads;
+
+pub use run::run;
+pub use theme::ColorChoice;
+
+/// What the command line sets for the screen.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Options {
+    /// Frames per second to aim at (default 30).
+    pub fps: f64,
+    pub color: ColorChoice,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            fps: 30.0,
+            color: ColorChoice::Auto,
+        }
+    }
+}

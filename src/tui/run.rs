@@ -1,0 +1,345 @@
+//! The frame loop and its pacing.
+use super::app::{self, View};
+use super::canvas::Raster;
+use super::guard::{self, Guard, Msg};
+use super::output::{BEGIN_SYNC, BUFFER_BYTES, Counting, END_SYNC, Lean};
+use super::readouts::Stats;
+use super::state::AppState;
+use super::theme::Palette;
+use super::{Options, input};
+use crate::cpu::{CpuReport, Sampler};
+use crate::engine::{Command, Engine, Settings, Snapshot};
+use crate::error::BadInput;
+use crate::physics::World;
+use anyhow::{Context, anyhow};
+use crossbeam_channel::{Receiver, RecvTimeoutError};
+use ratatui::Terminal;
+use ratatui::backend::Backend;
+use std::io::{self, BufWriter, IsTerminal, Stdout, Write};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
+
+/// Per-thread CPU is sampled once a second: a minute of history is 60 bars.
+const SAMPLE_PERIOD: Duration = Duration::from_secs(1);
+
+/// Open the screen on `world` and run until the user quits.
+pub fn run(world: World, settings: Settings, opts: Options) -> anyhow::Result<()> {
+    if !(opts.fps.is_finite() && opts.fps > 0.0 && opts.fps <= 1000.0) {
+        return Err(BadInput(format!(
+            "--fps must be between 0 and 1000, got {}",
+            opts.fps
+        ))
+        .into());
+    }
+    if !(io::stdin().is_terminal() && io::stdout().is_terminal()) {
+        return Err(BadInput(
+            "ballpit's screen needs a terminal, but stdin or stdout is not one; \
+             for a headless run use `ballpit bench`"
+                .into(),
+        )
+        .into());
+    }
+    let env = |k: &str| std::env::var(k).ok();
+    let palette = Palette::resolve(opts.color, &env);
+    let detected = Palette::detect(&env);
+    // crossterm drops colours itself under NO_COLOR; the resolved palette
+    // already says whether there are any (a --color flag overrides NO_COLOR).
+    crossterm::style::Colored::set_ansi_color_disabled(!palette.has_color());
+    let state = AppState::new(
+        &settings,
+        world.spheres.len(),
+        world.spheres.iter().map(|s| s.radius).fold(0.0, f64::max),
+        opts.fps,
+    );
+    let engine = Engine::new(world, settings)?;
+
+    let (tx, rx) = crossbeam_channel::unbounded();
+    let guard = Guard::enter(tx.clone()).context("cannot set up the terminal")?;
+    let signals = guard::spawn_signals(tx.clone())?;
+    guard::spawn_input(tx)?;
+    // For the end-to-end test of a panic off the main thread.
+    if std::env::var_os("BALLPIT_TEST_PANIC_THREAD").is_some() {
+        std::thread::Builder::new()
+            .name("test-panic".into())
+            .spawn(|| {
+                std::thread::sleep(Duration::from_millis(300));
+                panic!("test panic in a worker thread");
+            })?;
+    }
+    let result = FrameLoop::new(engine, state, palette, detected).and_then(|l| l.run(rx));
+    signals.close();
+    drop(guard);
+    result
+}
+
+type Term = Terminal<Lean<Counting<BufWriter<Stdout>>>>;
+
+struct FrameLoop {
+    engine: Engine,
+    state: AppState,
+    palette: Palette,
+    terminal: Term,
+    bytes: Arc<AtomicU64>,
+    raster: Raster,
+    stats: Stats,
+    sampler: Sampler,
+    report: CpuReport,
+    aspect: f64,
+    /// The tick the engine was last told (0 while paused).
+    sent_tick: u32,
+    /// Commands sent that no frame has applied yet.
+    pending: bool,
+    /// A frame was started and not finished; whether it applied commands.
+    in_flight: Option<bool>,
+    /// Something on screen would change.
+    dirty: bool,
+    window: Window,
+}
+
+/// Counts over the current one-second window for the per-second figures.
+#[derive(Default)]
+struct Window {
+    start: Option<Instant>,
+    frames: u32,
+    steps: u64,
+    collisions_at_start: u64,
+    physics_frames: u32,
+    physics_seconds: f64,
+    render_seconds: f64,
+    bytes: u64,
+}
+
+impl FrameLoop {
+    fn new(
+        engine: Engine,
+        state: AppState,
+        palette: Palette,
+        detected: Palette,
+    ) -> anyhow::Result<FrameLoop> {
+        let (writer, bytes) = Counting::new(BufWriter::with_capacity(BUFFER_BYTES, io::stdout()));
+        let mut terminal = Terminal::new(Lean::new(writer))?;
+        // Not `Terminal::clear`: it asks the terminal for the cursor position,
+        // a round trip that a slow link or a dumb pty may never answer.
+        Backend::clear(terminal.backend_mut())?;
+        let sent_tick = engine.settings().tick;
+        let collisions = collisions(engine.snapshot());
+        let mut sampler = Sampler::new();
+        let report = sampler.sample().clone();
+        Ok(FrameLoop {
+            engine,
+            state,
+            palette,
+            terminal,
+            bytes,
+            raster: Raster::new(),
+            stats: Stats {
+                detected: Some(detected),
+                ..Stats::default()
+            },
+            sampler,
+            report,
+            aspect: cell_aspect(),
+            sent_tick,
+            pending: false,
+            in_flight: None,
+            dirty: true,
+            window: Window {
+                start: Some(Instant::now()),
+                collisions_at_start: collisions,
+                ..Window::default()
+            },
+        })
+    }
+
+    fn run(mut self, rx: Receiver<Msg>) -> anyhow::Result<()> {
+        let mut next_frame = Instant::now();
+        let mut next_sample = Instant::now() + SAMPLE_PERIOD;
+        loop {
+            let wants_frame =
+                self.state.running() || self.pending || self.dirty || self.in_flight.is_some();
+            let deadline = if wants_frame {
+                next_frame.min(next_sample)
+            } else {
+                next_sample
+            };
+            let first = match rx.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
+                Ok(m) => Some(m),
+                Err(RecvTimeoutError::Timeout) => None,
+                Err(RecvTimeoutError::Disconnected) => {
+                    return Err(anyhow!("the input and signal threads stopped"));
+                }
+            };
+            let mut answered_key = false;
+            for msg in first.into_iter().chain(rx.try_iter()) {
+                answered_key |= self.handle(msg)?;
+            }
+            if guard::panicked() {
+                return Err(anyhow!("a thread panicked (message above)"));
+            }
+            if self.state.quit {
+                return Ok(());
+            }
+            let now = Instant::now();
+            if now >= next_sample {
+                self.sample(now);
+                next_sample = later(next_sample, SAMPLE_PERIOD, now);
+            }
+            if now >= next_frame {
+                let period = Duration::from_secs_f64(1.0 / self.state.fps);
+                next_frame = later(next_frame, period, now);
+                self.frame()?;
+            } else if answered_key {
+                // Answer keys at once rather than at the next frame.
+                self.draw()?;
+            }
+        }
+    }
+
+    /// Returns whether the screen should answer at once.
+    fn handle(&mut self, msg: Msg) -> anyhow::Result<bool> {
+        match msg {
+            Msg::Key(k) => {
+                let Some(action) = input::action(k) else {
+                    return Ok(false);
+                };
+                for cmd in self.state.apply(action) {
+                    self.engine.command(cmd);
+                    self.pending = true;
+                }
+                self.dirty = true;
+                Ok(true)
+            }
+            Msg::Resize => {
+                self.aspect = cell_aspect();
+                self.terminal.autoresize()?;
+                self.dirty = true;
+                Ok(true)
+            }
+            Msg::Signal(sig) => Err(anyhow!("stopped by {}", signal_name(sig))),
+            Msg::Fatal(why) => Err(anyhow!(why)),
+            Msg::Panic => Err(anyhow!("a thread panicked (message above)")),
+        }
+    }
+
+    /// One frame: collect the physics started last frame, start the next,
+    /// and draw while it computes. The physics thus has the whole frame
+    /// period, the drawing and the wait for keys included, and the loop
+    /// only waits for it when it is slower than the frame rate.
+    fn frame(&mut self) -> anyhow::Result<()> {
+        if let Some(applied) = self.in_flight.take() {
+            let snap = self.engine.finish_frame()?;
+            self.window.steps += snap.steps;
+            self.window.physics_frames += 1;
+            self.window.physics_seconds += snap.physics_seconds;
+            self.state.sync(snap, applied);
+            self.dirty = true;
+        }
+        if self.state.running() || self.pending {
+            let tick = if self.state.running() {
+                self.state.tick
+            } else {
+                0
+            };
+            if tick != self.sent_tick {
+                self.engine.command(Command::SetTick(tick));
+                self.sent_tick = tick;
+            }
+            self.engine.start_frame()?;
+            self.in_flight = Some(self.pending);
+            self.pending = false;
+        }
+        if self.dirty {
+            self.draw()?;
+        }
+        Ok(())
+    }
+
+    fn draw(&mut self) -> anyhow::Result<()> {
+        let t0 = Instant::now();
+        let before = self.bytes.load(Ordering::Relaxed);
+        let view = View {
+            state: &self.state,
+            snap: self.engine.snapshot(),
+            stats: &self.stats,
+            report: &self.report,
+            palette: self.palette,
+            aspect: self.aspect,
+        };
+        let raster = &mut self.raster;
+        // Any write error means the terminal is gone: the `?`s end the app.
+        self.terminal.backend_mut().write_all(BEGIN_SYNC)?;
+        self.terminal.draw(|f| app::draw(f, raster, &view))?;
+        let backend = self.terminal.backend_mut();
+        backend.write_all(END_SYNC)?;
+        Backend::flush(backend)?;
+        self.window.render_seconds += t0.elapsed().as_secs_f64();
+        self.window.bytes += self.bytes.load(Ordering::Relaxed) - before;
+        self.window.frames += 1;
+        self.dirty = false;
+        Ok(())
+    }
+
+    fn sample(&mut self, now: Instant) {
+        self.report = self.sampler.sample().clone();
+        // Figures are per-second averages: they read better than values
+        // that change every frame, and they cost bytes only once a second.
+        let w = &self.window;
+        let secs = now
+            .duration_since(w.start.unwrap_or(now))
+            .as_secs_f64()
+            .max(1e-9);
+        let total = collisions(self.engine.snapshot());
+        let st = &mut self.stats;
+        st.fps = f64::from(w.frames) / secs;
+        st.steps_per_second = w.steps as f64 / secs;
+        st.collisions_per_second = total.saturating_sub(w.collisions_at_start) as f64 / secs;
+        if w.frames > 0 {
+            st.render_seconds = w.render_seconds / f64::from(w.frames);
+            st.frame_bytes = w.bytes / u64::from(w.frames);
+        }
+        if w.physics_frames > 0 {
+            st.physics_seconds = w.physics_seconds / f64::from(w.physics_frames);
+        }
+        self.window = Window {
+            start: Some(now),
+            collisions_at_start: total,
+            ..Window::default()
+        };
+        self.dirty = true;
+    }
+}
+
+/// The next deadline after `prev` by `period`, without piling up missed ones.
+fn later(prev: Instant, period: Duration, now: Instant) -> Instant {
+    let next = prev + period;
+    if next <= now { now + period } else { next }
+}
+
+fn collisions(snap: &Snapshot) -> u64 {
+    snap.counters.sphere_collisions + snap.counters.wall_collisions
+}
+
+/// Cell height over width, from the terminal's pixel size when it says;
+/// 2 is the usual font.
+fn cell_aspect() -> f64 {
+    match crossterm::terminal::window_size() {
+        Ok(w) if w.width > 0 && w.height > 0 && w.columns > 0 && w.rows > 0 => {
+            let cw = f64::from(w.width) / f64::from(w.columns);
+            let ch = f64::from(w.height) / f64::from(w.rows);
+            (ch / cw).clamp(1.0, 3.0)
+        }
+        _ => 2.0,
+    }
+}
+
+fn signal_name(sig: i32) -> String {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGQUIT, SIGTERM};
+    match sig {
+        SIGHUP => "SIGHUP (the terminal hung up)".into(),
+        SIGINT => "SIGINT".into(),
+        SIGQUIT => "SIGQUIT".into(),
+        SIGTERM => "SIGTERM".into(),
+        n => format!("signal {n}"),
+    }
+}

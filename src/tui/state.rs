@@ -1,0 +1,223 @@
+//! What the user has asked for, and what each key does to it. Commands for
+//! the engine come out of `apply`; nothing here touches a terminal.
+use super::canvas::{DrawStyle, LIGHT_STEPS};
+use super::input::Action;
+use super::projection::Camera;
+use crate::engine::{Command, Settings, Snapshot, Threading};
+use crate::physics::ModelKind;
+
+pub const MAX_TICK: u32 = 1000;
+pub const MAX_THREADS: usize = 256;
+pub const MAX_COUNT: usize = 1 << 21;
+pub const MIN_RADIUS: f64 = 1e-4;
+pub const RADIUS_STEP: f64 = 1.25;
+pub const CAMERA_STEP: f64 = std::f64::consts::PI / 18.0;
+pub const MAX_PITCH: f64 = 1.5;
+pub const FPS_STEPS: [f64; 7] = [5.0, 10.0, 15.0, 20.0, 30.0, 60.0, 120.0];
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct AppState {
+    pub threading: Threading,
+    /// Where `t` goes back to; `d` cycles it while threading is off.
+    pub last_threaded: Threading,
+    pub threads: usize,
+    pub tick: u32,
+    pub paused: bool,
+    pub model: ModelKind,
+    pub count: usize,
+    pub radius: f64,
+    pub camera: Camera,
+    pub style: DrawStyle,
+    pub light: u8,
+    pub help: bool,
+    pub fps: f64,
+    pub quit: bool,
+    /// A limit a key ran into, shown until the next key.
+    pub notice: Option<String>,
+}
+
+impl AppState {
+    pub fn new(settings: &Settings, count: usize, radius: f64, fps: f64) -> AppState {
+        AppState {
+            threading: settings.threading,
+            last_threaded: if settings.threading == Threading::Off {
+                Threading::Worker
+            } else {
+                settings.threading
+            },
+            threads: settings.threads.max(1),
+            tick: settings.tick,
+            paused: false,
+            model: settings.model,
+            count,
+            radius,
+            camera: Camera::default(),
+            style: DrawStyle::PointsSpeed,
+            light: 0,
+            help: false,
+            fps,
+            quit: false,
+            notice: None,
+        }
+    }
+
+    /// Whether frames should step the physics.
+    pub fn running(&self) -> bool {
+        !self.paused && self.tick > 0
+    }
+
+    /// Do one key; returns what the engine must be told.
+    pub fn apply(&mut self, action: Action) -> Vec<Command> {
+        self.notice = None;
+        let mut out = Vec::new();
+        match action {
+            Action::Quit => self.quit = true,
+            Action::Escape => {
+                if self.help {
+                    self.help = false;
+                } else {
+                    self.quit = true;
+                }
+            }
+            Action::ToggleThreading => {
+                if self.threading == Threading::Off {
+                    self.threading = self.last_threaded;
+                } else {
+                    self.last_threaded = self.threading;
+                    self.threading = Threading::Off;
+                }
+                out.push(Command::SetThreading(self.threading));
+            }
+            Action::CycleThreadedMode => {
+                if self.threading == Threading::Off {
+                    self.last_threaded = self.last_threaded.next_threaded();
+                    self.notice = Some(format!(
+                        "t will switch to {} (threading is off)",
+                        self.last_threaded
+                    ));
+                } else {
+                    self.threading = self.threading.next_threaded();
+                    self.last_threaded = self.threading;
+                    out.push(Command::SetThreading(self.threading));
+                }
+            }
+            Action::FewerThreads | Action::MoreThreads => {
+                let want = if action == Action::MoreThreads {
+                    (self.threads + 1).min(MAX_THREADS)
+                } else {
+                    self.threads.saturating_sub(1).max(1)
+                };
+                if want == self.threads {
+                    self.notice = Some(format!("pool threads limit: {want}"));
+                } else {
+                    self.threads = want;
+                    out.push(Command::SetThreads(want));
+                }
+                if self.threading != Threading::Pool && self.notice.is_none() {
+                    self.notice = Some(format!("pool threads {want} (used in pool mode)"));
+                }
+            }
+            Action::TickDown => {
+                if self.tick == 0 {
+                    self.notice = Some("tick 0: physics frozen".into());
+                } else {
+                    self.tick -= 1;
+                }
+            }
+            Action::TickUp => {
+                if self.tick >= MAX_TICK {
+                    self.notice = Some(format!("tick limit: {MAX_TICK}"));
+                } else {
+                    self.tick += 1;
+                }
+            }
+            Action::Pause => self.paused = !self.paused,
+            Action::HalveCount => {
+                if self.count <= 1 {
+                    self.notice = Some("count limit: 1 sphere".into());
+                } else {
+                    self.count = self.count.div_ceil(2);
+                    out.push(Command::SetCount(self.count));
+                }
+            }
+            Action::DoubleCount => {
+                if self.count * 2 > MAX_COUNT {
+                    self.notice = Some(format!("count limit: {MAX_COUNT}"));
+                } else {
+                    self.count = (self.count * 2).max(1);
+                    out.push(Command::SetCount(self.count));
+                }
+            }
+            Action::Smaller => {
+                let want = self.radius / RADIUS_STEP;
+                if want < MIN_RADIUS {
+                    self.notice = Some(format!("radius limit: {MIN_RADIUS}"));
+                } else {
+                    self.radius = want;
+                    out.push(Command::SetRadius(want));
+                }
+            }
+            Action::Bigger => {
+                self.radius *= RADIUS_STEP;
+                out.push(Command::SetRadius(self.radius));
+            }
+            Action::CycleModel => {
+                self.model = self.model.next();
+                out.push(Command::SetModel(self.model));
+            }
+            Action::Left => self.camera.yaw -= CAMERA_STEP,
+            Action::Right => self.camera.yaw += CAMERA_STEP,
+            Action::Up => self.camera.pitch = (self.camera.pitch + CAMERA_STEP).min(MAX_PITCH),
+            Action::Down => self.camera.pitch = (self.camera.pitch - CAMERA_STEP).max(-MAX_PITCH),
+            Action::CycleStyle => self.style = self.style.next(),
+            Action::MoveLight => {
+                self.light = (self.light + 1) % LIGHT_STEPS;
+                if self.style != DrawStyle::Shaded {
+                    self.notice = Some("the light shows in the shaded style (v)".into());
+                }
+            }
+            Action::Reset => out.push(Command::Reset),
+            Action::Help => self.help = !self.help,
+            Action::SlowerFps => match FPS_STEPS.iter().rev().find(|&&f| f < self.fps - 1e-9) {
+                Some(&f) => self.fps = f,
+                None => self.notice = Some(format!("fps limit: {}", FPS_STEPS[0])),
+            },
+            Action::FasterFps => match FPS_STEPS.iter().find(|&&f| f > self.fps + 1e-9) {
+                Some(&f) => self.fps = f,
+                None => {
+                    self.notice = Some(format!("fps limit: {}", FPS_STEPS[FPS_STEPS.len() - 1]))
+                }
+            },
+        }
+        out
+    }
+
+    /// Take what the engine really did (count and radius may stop at a
+    /// limit; reset restores the scene). `applied`: this frame applied our
+    /// commands, so its notice (or the lack of one) answers them.
+    pub fn sync(&mut self, snap: &Snapshot, applied: bool) {
+        self.count = snap.spheres.len();
+        if let Some(r) = representative_radius(snap) {
+            self.radius = r;
+        }
+        if applied {
+            self.notice.clone_from(&snap.notice);
+        }
+    }
+}
+
+/// The radius the `r`/`R` keys scale: the largest one (for mixed scenes the
+/// largest sphere is what hits the limit first).
+pub fn representative_radius(snap: &Snapshot) -> Option<f64> {
+    snap.spheres.iter().map(|s| s.radius).reduce(f64::max)
+}
+
+/// Physics threads a mode uses, for the readout.
+pub fn physics_threads(threading: Threading, pool: usize) -> usize {
+    match threading {
+        Threading::Off => 0,
+        Threading::Worker => 1,
+        Threading::Pool => pool,
+        Threading::Split => 2,
+    }
+}

@@ -1,0 +1,272 @@
+//! Every key's effect on the app state, without a terminal.
+use ballpit::engine::{Command, Settings, Threading};
+use ballpit::physics::ModelKind;
+use ballpit::tui::canvas::{DrawStyle, LIGHT_STEPS};
+use ballpit::tui::input::{Action, action};
+use ballpit::tui::state::{AppState, CAMERA_STEP, MAX_PITCH, MAX_TICK, MIN_RADIUS, RADIUS_STEP};
+use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+
+fn settings() -> Settings {
+    Settings {
+        model: ModelKind::Swept,
+        dt: 1.0 / 60.0,
+        tick: 1,
+        threading: Threading::Off,
+        threads: 4,
+    }
+}
+
+fn app() -> AppState {
+    AppState::new(&settings(), 1000, 0.02, 30.0)
+}
+
+fn key(app: &mut AppState, code: KeyCode) -> Vec<Command> {
+    let a = action(KeyEvent::new(code, KeyModifiers::NONE)).expect("a mapped key");
+    app.apply(a)
+}
+
+#[test]
+fn q_esc_and_ctrl_c_quit() {
+    for code in [KeyCode::Char('q'), KeyCode::Esc] {
+        let mut a = app();
+        assert!(key(&mut a, code).is_empty());
+        assert!(a.quit, "{code:?}");
+    }
+    let mut a = app();
+    let ctrl_c = action(KeyEvent::new(KeyCode::Char('c'), KeyModifiers::CONTROL)).unwrap();
+    a.apply(ctrl_c);
+    assert!(a.quit);
+}
+
+#[test]
+fn esc_closes_the_help_before_it_quits() {
+    let mut a = app();
+    key(&mut a, KeyCode::Char('?'));
+    assert!(a.help);
+    key(&mut a, KeyCode::Esc);
+    assert!(!a.help && !a.quit);
+    key(&mut a, KeyCode::Char('?'));
+    key(&mut a, KeyCode::Char('?'));
+    assert!(!a.help);
+}
+
+#[test]
+fn t_goes_off_to_the_last_threaded_mode_and_back() {
+    let mut a = app();
+    assert_eq!(
+        key(&mut a, KeyCode::Char('t')),
+        [Command::SetThreading(Threading::Worker)]
+    );
+    assert_eq!(a.threading, Threading::Worker);
+    key(&mut a, KeyCode::Char('d'));
+    assert_eq!(a.threading, Threading::Pool);
+    assert_eq!(
+        key(&mut a, KeyCode::Char('t')),
+        [Command::SetThreading(Threading::Off)]
+    );
+    assert_eq!(a.threading, Threading::Off);
+    assert_eq!(
+        key(&mut a, KeyCode::Char('t')),
+        [Command::SetThreading(Threading::Pool)]
+    );
+}
+
+#[test]
+fn d_cycles_worker_pool_split_and_only_picks_while_off() {
+    let mut a = app();
+    key(&mut a, KeyCode::Char('t'));
+    let mut seen = vec![];
+    for _ in 0..3 {
+        let cmds = key(&mut a, KeyCode::Char('d'));
+        assert_eq!(cmds, [Command::SetThreading(a.threading)]);
+        seen.push(a.threading);
+    }
+    assert_eq!(seen, [Threading::Pool, Threading::Split, Threading::Worker]);
+    // While off, `d` chooses what `t` will switch to, and sends nothing.
+    let mut a = app();
+    assert!(key(&mut a, KeyCode::Char('d')).is_empty());
+    assert_eq!(
+        (a.threading, a.last_threaded),
+        (Threading::Off, Threading::Pool)
+    );
+    assert!(a.notice.as_deref().unwrap().contains("pool"));
+    key(&mut a, KeyCode::Char('t'));
+    assert_eq!(a.threading, Threading::Pool);
+}
+
+#[test]
+fn p_and_shift_p_change_the_pool_within_limits() {
+    let mut a = app();
+    assert_eq!(key(&mut a, KeyCode::Char('P')), [Command::SetThreads(5)]);
+    assert_eq!(key(&mut a, KeyCode::Char('p')), [Command::SetThreads(4)]);
+    for _ in 0..3 {
+        key(&mut a, KeyCode::Char('p'));
+    }
+    assert_eq!(a.threads, 1);
+    assert!(key(&mut a, KeyCode::Char('p')).is_empty());
+    assert_eq!(a.threads, 1);
+    assert!(a.notice.as_deref().unwrap().contains("limit"));
+}
+
+#[test]
+fn brackets_change_the_tick_and_zero_freezes() {
+    let mut a = app();
+    // The tick goes to the engine at the next frame (0 while paused), so the
+    // key itself sends nothing.
+    assert!(key(&mut a, KeyCode::Char(']')).is_empty());
+    assert_eq!(a.tick, 2);
+    key(&mut a, KeyCode::Char('['));
+    key(&mut a, KeyCode::Char('['));
+    assert_eq!(a.tick, 0);
+    assert!(!a.running());
+    key(&mut a, KeyCode::Char('['));
+    assert_eq!(a.tick, 0);
+    assert!(a.notice.as_deref().unwrap().contains("frozen"));
+    a.tick = MAX_TICK;
+    key(&mut a, KeyCode::Char(']'));
+    assert_eq!(a.tick, MAX_TICK);
+}
+
+#[test]
+fn space_pauses_and_resumes() {
+    let mut a = app();
+    assert!(a.running());
+    key(&mut a, KeyCode::Char(' '));
+    assert!(a.paused && !a.running());
+    key(&mut a, KeyCode::Char(' '));
+    assert!(a.running());
+}
+
+#[test]
+fn n_halves_and_shift_n_doubles_the_count() {
+    let mut a = app();
+    assert_eq!(key(&mut a, KeyCode::Char('N')), [Command::SetCount(2000)]);
+    assert_eq!(key(&mut a, KeyCode::Char('n')), [Command::SetCount(1000)]);
+    a.count = 1;
+    assert!(key(&mut a, KeyCode::Char('n')).is_empty());
+    assert_eq!(a.count, 1);
+}
+
+#[test]
+fn r_and_shift_r_scale_the_radius() {
+    let mut a = app();
+    let cmds = key(&mut a, KeyCode::Char('R'));
+    assert_eq!(cmds, [Command::SetRadius(0.02 * RADIUS_STEP)]);
+    let cmds = key(&mut a, KeyCode::Char('r'));
+    assert_eq!(cmds, [Command::SetRadius(0.02 * RADIUS_STEP / RADIUS_STEP)]);
+    a.radius = MIN_RADIUS;
+    assert!(key(&mut a, KeyCode::Char('r')).is_empty());
+    assert_eq!(a.radius, MIN_RADIUS);
+}
+
+#[test]
+fn m_cycles_the_model() {
+    let mut a = app();
+    let first = a.model;
+    let cmds = key(&mut a, KeyCode::Char('m'));
+    assert_eq!(cmds, [Command::SetModel(first.next())]);
+    assert_ne!(a.model, first);
+    for _ in 1..ModelKind::ALL.len() {
+        key(&mut a, KeyCode::Char('m'));
+    }
+    assert_eq!(a.model, first);
+}
+
+#[test]
+fn arrows_rotate_the_camera_and_pitch_stops_short_of_the_pole() {
+    let mut a = app();
+    let c0 = a.camera;
+    key(&mut a, KeyCode::Left);
+    assert!((a.camera.yaw - (c0.yaw - CAMERA_STEP)).abs() < 1e-12);
+    key(&mut a, KeyCode::Right);
+    key(&mut a, KeyCode::Right);
+    assert!((a.camera.yaw - (c0.yaw + CAMERA_STEP)).abs() < 1e-12);
+    key(&mut a, KeyCode::Up);
+    assert!((a.camera.pitch - (c0.pitch + CAMERA_STEP)).abs() < 1e-12);
+    key(&mut a, KeyCode::Down);
+    key(&mut a, KeyCode::Down);
+    assert!((a.camera.pitch - (c0.pitch - CAMERA_STEP)).abs() < 1e-12);
+    for _ in 0..40 {
+        key(&mut a, KeyCode::Up);
+    }
+    assert_eq!(a.camera.pitch, MAX_PITCH);
+}
+
+#[test]
+fn v_cycles_the_styles_and_l_moves_the_light_round() {
+    let mut a = app();
+    assert_eq!(a.style, DrawStyle::PointsSpeed);
+    key(&mut a, KeyCode::Char('v'));
+    assert_eq!(a.style, DrawStyle::PointsDepth);
+    key(&mut a, KeyCode::Char('v'));
+    assert_eq!(a.style, DrawStyle::Shaded);
+    key(&mut a, KeyCode::Char('v'));
+    assert_eq!(a.style, DrawStyle::PointsSpeed);
+    key(&mut a, KeyCode::Char('l'));
+    assert!(a.notice.as_deref().unwrap().contains("shaded"));
+    a.style = DrawStyle::Shaded;
+    for i in 2..=LIGHT_STEPS + 1 {
+        key(&mut a, KeyCode::Char('l'));
+        assert_eq!(a.light, i % LIGHT_STEPS);
+        assert!(a.notice.is_none());
+    }
+}
+
+#[test]
+fn zero_resets_the_scene() {
+    let mut a = app();
+    assert_eq!(key(&mut a, KeyCode::Char('0')), [Command::Reset]);
+}
+
+#[test]
+fn f_and_shift_f_step_the_frame_rate() {
+    let mut a = app();
+    key(&mut a, KeyCode::Char('F'));
+    assert_eq!(a.fps, 60.0);
+    key(&mut a, KeyCode::Char('f'));
+    key(&mut a, KeyCode::Char('f'));
+    assert_eq!(a.fps, 20.0);
+    let mut b = AppState::new(&settings(), 10, 0.1, 24.0);
+    b.apply(Action::FasterFps);
+    assert_eq!(b.fps, 30.0);
+    for _ in 0..10 {
+        b.apply(Action::SlowerFps);
+    }
+    assert_eq!(b.fps, 5.0);
+}
+
+#[test]
+fn threading_given_on_the_command_line_is_what_t_returns_to() {
+    let mut s = settings();
+    s.threading = Threading::Split;
+    let mut a = AppState::new(&s, 10, 0.1, 30.0);
+    key(&mut a, KeyCode::Char('t'));
+    assert_eq!(a.threading, Threading::Off);
+    key(&mut a, KeyCode::Char('t'));
+    assert_eq!(a.threading, Threading::Split);
+}
+
+#[test]
+fn sync_takes_the_real_count_radius_and_the_engine_notice() {
+    use ballpit::engine::Engine;
+    use ballpit::physics::{Sphere, World};
+    use glam::DVec3;
+    let spheres = vec![
+        Sphere::new(DVec3::splat(0.3), DVec3::X, 0.05),
+        Sphere::new(DVec3::splat(0.7), DVec3::Y, 0.1),
+    ];
+    let engine = Engine::new(World::new(1.0, spheres), settings()).unwrap();
+    let mut snap = engine.snapshot().clone();
+    let mut a = app();
+    key(&mut a, KeyCode::Char('N'));
+    snap.notice = Some("count limit: no free space".into());
+    a.sync(&snap, true);
+    assert_eq!((a.count, a.radius), (2, 0.1));
+    assert_eq!(a.notice.as_deref(), Some("count limit: no free space"));
+    // A frame that applied nothing of ours leaves the notice alone.
+    snap.notice = None;
+    a.sync(&snap, false);
+    assert!(a.notice.is_some());
+    a.sync(&snap, true);
+    assert!(a.notice.is_none());
+}
