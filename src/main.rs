@@ -3,6 +3,7 @@ use ballpit::cli::{Cli, Command};
 use ballpit::error::BadInput;
 use ballpit::{bench, scene};
 use clap::Parser;
+use std::io::Write;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -11,10 +12,11 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             if let Some(bad) = e.downcast_ref::<BadInput>() {
-                eprintln!("ballpit: {bad}");
+                // stderr may be gone with the terminal: never panic for it.
+                let _ = writeln!(std::io::stderr(), "ballpit: {bad}");
                 ExitCode::from(2)
             } else {
-                eprintln!("ballpit: {e:#}");
+                let _ = writeln!(std::io::stderr(), "ballpit: {e:#}");
                 ExitCode::FAILURE
             }
         }
@@ -24,7 +26,11 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Bench(args)) => {
-            let settings = args.run.settings()?;
+            let mut settings = args.run.settings()?;
+            settings.tick = args
+                .run
+                .tick
+                .unwrap_or_else(|| args.steps.div_ceil(100).clamp(1, u64::from(u32::MAX)) as u32);
             let world = scene::build_world(&args.scene.spec())?;
             let (report, world) = bench::run(world, &settings, args.steps)?;
             if let Some(path) = &args.dump {

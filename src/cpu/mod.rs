@@ -1,5 +1,13 @@
-//! Per-thread CPU load of this process. (Placeholder API: the threading
-//! issue fills it in.)
+//! Per-thread CPU load of this process, read from procfs on Linux
+//! (`/proc/self/task/*/schedstat`, nanosecond run time, falling back to the
+//! clock ticks of `stat`), by thread name from `comm`. Elsewhere the report
+//! holds only the core count.
+mod task;
+
+pub use task::{current_tid, thread_cpu_seconds_of};
+
+use std::collections::{HashMap, VecDeque};
+use std::time::{Duration, Instant};
 
 /// One thread's load.
 #[derive(Clone, Debug, PartialEq)]
@@ -22,20 +30,114 @@ pub struct CpuReport {
     pub cores: usize,
 }
 
-/// Samples `/proc/self/task/*` (Linux) on demand.
-#[derive(Default)]
+/// How long the load is averaged over.
+pub const WINDOW: Duration = Duration::from_secs(1);
+/// One history point per this much time...
+pub const HISTORY_STEP: Duration = Duration::from_millis(500);
+/// ...and this many points: a minute of sparkline.
+pub const HISTORY_LEN: usize = 120;
+
+struct Track {
+    name: String,
+    /// (when, CPU seconds) samples covering at least the window.
+    samples: VecDeque<(Instant, f64)>,
+    history: VecDeque<f64>,
+    seen: bool,
+}
+
+/// Samples `/proc/self/task/*` (Linux) on demand; call `sample` as often as
+/// the screen refreshes, the window and history are kept in wall time.
 pub struct Sampler {
     report: CpuReport,
+    tracks: HashMap<i32, Track>,
+    last_history: Option<Instant>,
+    cores: usize,
+}
+
+impl Default for Sampler {
+    fn default() -> Self {
+        Sampler::new()
+    }
 }
 
 impl Sampler {
     pub fn new() -> Sampler {
-        Sampler::default()
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        Sampler {
+            report: CpuReport {
+                cores,
+                ..CpuReport::default()
+            },
+            tracks: HashMap::new(),
+            last_history: None,
+            cores,
+        }
     }
+
     /// Take a sample now and return the updated report.
     pub fn sample(&mut self) -> &CpuReport {
+        let now = Instant::now();
+        for t in self.tracks.values_mut() {
+            t.seen = false;
+        }
+        for (tid, name, secs) in task::read_threads() {
+            let t = self.tracks.entry(tid).or_insert_with(|| Track {
+                name: String::new(),
+                samples: VecDeque::new(),
+                history: VecDeque::new(),
+                seen: false,
+            });
+            t.name = name;
+            t.seen = true;
+            t.samples.push_back((now, secs));
+            // Keep one sample at least a window old, so the rate spans it.
+            while t.samples.len() > 2 && now.duration_since(t.samples[1].0) >= WINDOW {
+                t.samples.pop_front();
+            }
+        }
+        self.tracks.retain(|_, t| t.seen);
+        let push_history = self
+            .last_history
+            .is_none_or(|h| now.duration_since(h) >= HISTORY_STEP);
+        if push_history {
+            self.last_history = Some(now);
+        }
+        let mut threads: Vec<ThreadLoad> = self
+            .tracks
+            .iter_mut()
+            .map(|(&tid, t)| {
+                let &(t1, c1) = t.samples.back().expect("sampled just now");
+                let &(t0, c0) = t.samples.front().expect("sampled just now");
+                let wall = t1.duration_since(t0).as_secs_f64();
+                let percent = if wall > 0.0 {
+                    ((c1 - c0) / wall * 100.0).max(0.0)
+                } else {
+                    0.0
+                };
+                if push_history {
+                    t.history.push_back(percent);
+                    while t.history.len() > HISTORY_LEN {
+                        t.history.pop_front();
+                    }
+                }
+                ThreadLoad {
+                    tid,
+                    name: t.name.clone(),
+                    percent,
+                    cpu_seconds: c1,
+                    history: t.history.iter().copied().collect(),
+                }
+            })
+            .collect();
+        threads.sort_by_key(|t| t.tid);
+        self.report = CpuReport {
+            total_percent: threads.iter().map(|t| t.percent).sum(),
+            threads,
+            cores: self.cores,
+        };
         &self.report
     }
+
     pub fn report(&self) -> &CpuReport {
         &self.report
     }
@@ -43,5 +145,8 @@ impl Sampler {
 
 /// Every thread of the process with its CPU seconds, for the bench JSON.
 pub fn thread_cpu_seconds() -> Vec<(String, f64)> {
-    Vec::new()
+    task::read_threads()
+        .into_iter()
+        .map(|(_, name, secs)| (name, secs))
+        .collect()
 }

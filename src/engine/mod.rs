@@ -4,10 +4,31 @@
 //! API contract (the TUI and `bench` depend on it; extend, don't break):
 //! `Engine::new`, `command`, `start_frame`, `finish_frame`, `snapshot`,
 //! `settings`, `world`.
-use crate::physics::{Counters, Model, ModelKind, Serial, World};
+//!
+//! Threads: `physics` (created with the engine, asleep on a channel until a
+//! frame is handed to it) drives every threaded mode; `pool` lends it
+//! `pool-0..K-1` for the data-parallel sections, `split` lends it
+//! `split-pair` and `split-wall` for the two functional jobs. The physics
+//! cuts its work into fixed blocks combined in block order, so every mode
+//! gives the same bits. The frame (world, model, executor, back snapshot)
+//! moves whole to the thread that runs it and back, so no lock guards the
+//! world and a mode switch between frames cannot lose or repeat anything.
+mod frame;
+mod pool;
+mod snapshot;
+mod worker;
+
+pub use pool::{PoolExec, SPLIT_NAMES, SplitExec};
+pub use snapshot::{Snapshot, SphereView};
+
+use crate::physics::{Model, ModelKind, Serial, World, edit};
+use frame::{Frame, SharedExec};
+use rand::SeedableRng;
+use rand_xoshiro::Xoshiro256PlusPlus;
 use std::fmt;
 use std::str::FromStr;
-use std::time::Instant;
+use std::sync::Arc;
+use worker::Worker;
 
 /// Where the physics runs (DESIGN.md, Threading).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -84,110 +105,84 @@ pub enum Command {
     SetThreads(usize),
     SetTick(u32),
     SetModel(ModelKind),
-    /// New spheres go into free space; removal drops the last ones.
+    /// New spheres (median radius, rms speed, random directions) go into
+    /// free space; removal drops the last ones.
     SetCount(usize),
-    /// Growth stops where spheres would touch; the snapshot's notice says so.
+    /// Scale every radius so the largest becomes this (mass follows, same
+    /// density). Growth stops where spheres would touch; the snapshot's
+    /// notice says so.
     SetRadius(f64),
     /// Back to the scene as it started.
     Reset,
 }
 
-/// What the screen needs of one sphere.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SphereView {
-    pub pos: [f64; 3],
-    pub radius: f64,
-    pub speed: f64,
+/// The default pool size: the cores the system gives us.
+pub fn default_threads() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
-/// One finished frame, read by the renderer while the next one computes.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Snapshot {
-    pub frame: u64,
-    pub time: f64,
-    pub size: f64,
-    pub spheres: Vec<SphereView>,
-    pub energy: f64,
-    /// Energy right after the last reset (or scene start), for the drift.
-    pub energy_reset: f64,
-    pub max_overlap_rel: f64,
-    pub escaped: usize,
-    pub counters: Counters,
-    /// Wall-clock seconds the physics of this frame took.
-    pub physics_seconds: f64,
-    /// Steps run in this frame.
-    pub steps: u64,
-    /// The settings this frame ran with (what really ran).
-    pub settings: Settings,
-    /// A limit the last command hit, e.g. "radius limit: spheres touch".
-    pub notice: Option<String>,
-}
+/// Most pool threads `SetThreads` allows.
+pub const MAX_THREADS: usize = 256;
+/// Seeds the placement of spheres added by `SetCount`, so runs repeat.
+const EDIT_SEED: u64 = 0x62616c6c70697421;
 
-impl Snapshot {
-    fn capture(world: &World, settings: Settings, energy_reset: f64) -> Snapshot {
-        Snapshot {
-            frame: 0,
-            time: world.time,
-            size: world.size,
-            spheres: world
-                .spheres
-                .iter()
-                .map(|s| SphereView {
-                    pos: s.pos.to_array(),
-                    radius: s.radius,
-                    speed: s.vel.length(),
-                })
-                .collect(),
-            energy: world.kinetic_energy(),
-            energy_reset,
-            max_overlap_rel: world.max_overlap_rel(),
-            escaped: world.escaped(),
-            counters: world.counters,
-            physics_seconds: 0.0,
-            steps: 0,
-            settings,
-            notice: None,
-        }
-    }
-
-    /// `|E - E_reset| / E_reset` (0 for a world at rest).
-    pub fn energy_drift(&self) -> f64 {
-        if self.energy_reset > 0.0 {
-            (self.energy - self.energy_reset).abs() / self.energy_reset
-        } else {
-            0.0
-        }
-    }
-}
-
-/// Single-threaded placeholder of the engine: runs every mode on the calling
-/// thread. The threading issue replaces the inside, keeping this API.
+/// Owns the world and runs frames in the chosen threading mode.
+///
+/// Frame loop: `start_frame` (applies queued commands, then starts the
+/// physics of the next frame: on the `physics` thread in threaded modes,
+/// returning at once; on the caller when threading is off); draw
+/// `snapshot()` meanwhile; `finish_frame` waits for the frame and makes its
+/// snapshot current. Modes change only between frames, when the world is
+/// back home, so nothing is lost or repeated.
 pub struct Engine {
-    world: World,
+    /// The frame, while no thread is computing it.
+    home: Option<Box<Frame>>,
+    in_flight: bool,
+    front: Snapshot,
     initial: World,
-    model: Box<dyn Model>,
     settings: Settings,
     pending: Vec<Command>,
-    snapshot: Snapshot,
-    energy_reset: f64,
-    frame: u64,
+    worker: Worker,
+    serial: SharedExec,
+    pool: Option<Arc<PoolExec>>,
+    split: Option<Arc<SplitExec>>,
+    failed: Option<String>,
+    rng: Xoshiro256PlusPlus,
 }
 
 impl Engine {
     pub fn new(world: World, settings: Settings) -> anyhow::Result<Engine> {
-        let energy_reset = world.kinetic_energy();
+        let model = settings.model.build();
+        Engine::with_model(world, settings, model)
+    }
+
+    /// An engine running a model of the caller's (tests, instrumented runs).
+    pub fn with_model(
+        world: World,
+        mut settings: Settings,
+        model: Box<dyn Model>,
+    ) -> anyhow::Result<Engine> {
+        settings.threads = settings.threads.clamp(1, MAX_THREADS);
+        let serial: SharedExec = Arc::new(Serial);
+        let frame = Frame::new(world.clone(), model, serial.clone(), settings);
         Ok(Engine {
-            snapshot: Snapshot::capture(&world, settings, energy_reset),
-            initial: world.clone(),
-            model: settings.model.build(),
-            world,
+            front: frame.snap.clone(),
+            home: Some(Box::new(frame)),
+            in_flight: false,
+            initial: world,
             settings,
             pending: Vec::new(),
-            energy_reset,
-            frame: 0,
+            worker: Worker::spawn()?,
+            serial,
+            pool: None,
+            split: None,
+            failed: None,
+            rng: Xoshiro256PlusPlus::seed_from_u64(EDIT_SEED),
         })
     }
 
+    /// The settings the next frame runs with (commands queued since the
+    /// last `start_frame` are not in yet).
     pub fn settings(&self) -> &Settings {
         &self.settings
     }
@@ -197,50 +192,197 @@ impl Engine {
         self.pending.push(cmd);
     }
 
-    /// Begin computing the next frame (threaded modes return at once).
+    /// Begin computing the next frame: threaded modes return at once, `off`
+    /// computes it here. A frame still running is finished first.
     pub fn start_frame(&mut self) -> anyhow::Result<()> {
-        for cmd in std::mem::take(&mut self.pending) {
-            match cmd {
-                Command::SetThreading(t) => self.settings.threading = t,
-                Command::SetThreads(k) => self.settings.threads = k.max(1),
-                Command::SetTick(t) => self.settings.tick = t,
-                Command::SetModel(m) => {
-                    self.settings.model = m;
-                    self.model = m.build();
-                }
-                Command::SetCount(_) | Command::SetRadius(_) => {}
-                Command::Reset => {
-                    self.world = self.initial.clone();
-                    self.model = self.settings.model.build();
-                    self.energy_reset = self.world.kinetic_energy();
-                }
-            }
+        if self.in_flight {
+            self.finish_frame()?;
         }
-        let t0 = Instant::now();
-        let steps = u64::from(self.settings.tick);
-        self.model
-            .advance(&mut self.world, self.settings.dt, steps, &Serial);
-        let physics_seconds = t0.elapsed().as_secs_f64();
-        self.frame += 1;
-        self.snapshot = Snapshot::capture(&self.world, self.settings, self.energy_reset);
-        self.snapshot.frame = self.frame;
-        self.snapshot.physics_seconds = physics_seconds;
-        self.snapshot.steps = steps;
+        self.check()?;
+        let mut frame = self
+            .home
+            .take()
+            .expect("a healthy engine has its frame at home");
+        if let Err(e) = self.apply_commands(&mut frame) {
+            self.home = Some(frame);
+            return Err(e);
+        }
+        if self.settings.threading == Threading::Off {
+            let frame = worker::run_caught(frame).map_err(|e| self.fail(e))?;
+            self.land(frame);
+        } else {
+            self.worker
+                .start(frame)
+                .map_err(|e| self.fail(e.to_string()))?;
+            self.in_flight = true;
+        }
         Ok(())
     }
 
     /// Wait for the frame started last and make it the current snapshot.
     pub fn finish_frame(&mut self) -> anyhow::Result<&Snapshot> {
-        Ok(&self.snapshot)
+        if self.in_flight {
+            self.in_flight = false;
+            let frame = self.worker.wait().map_err(|e| self.fail(e))?;
+            self.land(frame);
+        }
+        self.check()?;
+        Ok(&self.front)
     }
 
     /// The latest finished frame.
     pub fn snapshot(&self) -> &Snapshot {
-        &self.snapshot
+        &self.front
     }
 
     /// The world between frames (after `finish_frame`).
+    ///
+    /// # Panics
+    /// While a frame is in flight or after the physics failed; see
+    /// [`Engine::try_world`].
     pub fn world(&self) -> &World {
-        &self.world
+        self.try_world()
+            .expect("Engine::world needs a finished frame: call finish_frame first")
+    }
+
+    /// The world, unless a frame is in flight or the physics failed.
+    pub fn try_world(&self) -> Option<&World> {
+        self.home.as_ref().map(|f| &f.world)
+    }
+
+    /// Whether a threaded frame is being computed.
+    pub fn in_flight(&self) -> bool {
+        self.in_flight
+    }
+
+    /// Kernel thread id of the `physics` thread (Linux), for CPU checks.
+    pub fn physics_tid(&self) -> Option<i32> {
+        self.worker.tid()
+    }
+
+    /// `(name, kernel thread id)` of every thread the engine has started so
+    /// far (Linux): `physics`, then the pool and split threads that exist.
+    pub fn thread_ids(&self) -> Vec<(String, i32)> {
+        let pool = self.pool.iter().flat_map(|p| p.thread_ids());
+        let split = self.split.iter().flat_map(|s| s.thread_ids());
+        self.worker
+            .tid()
+            .map(|t| ("physics".to_string(), t))
+            .into_iter()
+            .chain(pool)
+            .chain(split)
+            .collect()
+    }
+
+    /// The threads the current settings put physics work on, driver first.
+    /// A model that runs one event loop (`exact`) ignores the executor, so
+    /// in `pool` and `split` it runs on `physics` alone.
+    pub fn physics_threads(&self) -> Vec<String> {
+        let helpers: Vec<String> = match self.settings.threading {
+            Threading::Off => {
+                return vec![std::thread::current().name().unwrap_or("main").to_string()];
+            }
+            _ if self.settings.model.name() == "exact" => Vec::new(),
+            Threading::Worker => Vec::new(),
+            Threading::Pool => (0..self.settings.threads)
+                .map(|i| format!("pool-{i}"))
+                .collect(),
+            Threading::Split => SPLIT_NAMES.map(String::from).to_vec(),
+        };
+        std::iter::once("physics".to_string())
+            .chain(helpers)
+            .collect()
+    }
+
+    fn check(&self) -> anyhow::Result<()> {
+        match &self.failed {
+            Some(e) => Err(anyhow::anyhow!("{e}")),
+            None => Ok(()),
+        }
+    }
+
+    /// The physics died with the frame: the engine stays failed and says why.
+    fn fail(&mut self, msg: String) -> anyhow::Error {
+        self.failed = Some(msg.clone());
+        anyhow::anyhow!(msg)
+    }
+
+    /// A finished frame comes home; its snapshot becomes the front one.
+    fn land(&mut self, mut frame: Box<Frame>) {
+        std::mem::swap(&mut self.front, &mut frame.snap);
+        self.home = Some(frame);
+    }
+
+    fn apply_commands(&mut self, frame: &mut Frame) -> anyhow::Result<()> {
+        for cmd in std::mem::take(&mut self.pending) {
+            match cmd {
+                Command::SetThreading(t) => self.settings.threading = t,
+                Command::SetThreads(k) => self.settings.threads = k.clamp(1, MAX_THREADS),
+                Command::SetTick(t) => self.settings.tick = t,
+                Command::SetModel(m) => {
+                    self.settings.model = m;
+                    frame.model = m.build();
+                }
+                Command::SetCount(n) => {
+                    let w = &mut frame.world;
+                    let radius = edit::typical_radius(w)
+                        .or_else(|| edit::typical_radius(&self.initial))
+                        .unwrap_or(0.02 * w.size);
+                    let speed = if w.spheres.is_empty() {
+                        edit::rms_speed(&self.initial)
+                    } else {
+                        edit::rms_speed(w)
+                    };
+                    frame.notice = edit::set_count(w, n, radius, speed, &mut self.rng);
+                    self.edited(frame);
+                }
+                Command::SetRadius(r) => {
+                    frame.notice = edit::set_radius(&mut frame.world, r);
+                    self.edited(frame);
+                }
+                Command::Reset => {
+                    frame.world = self.initial.clone();
+                    frame.model = self.settings.model.build();
+                    frame.notice = None;
+                    frame.energy_reset = frame.world.kinetic_energy();
+                }
+            }
+        }
+        frame.settings = self.settings;
+        frame.exec = self.exec()?;
+        Ok(())
+    }
+
+    /// The spheres changed from outside the model.
+    fn edited(&self, frame: &mut Frame) {
+        frame.model.invalidate();
+        frame.energy_reset = frame.world.kinetic_energy();
+    }
+
+    /// The executor for the current mode; pools are made when first needed
+    /// and kept (asleep) while other modes run.
+    fn exec(&mut self) -> anyhow::Result<SharedExec> {
+        Ok(match self.settings.threading {
+            Threading::Off | Threading::Worker => self.serial.clone(),
+            Threading::Pool => {
+                let k = self.settings.threads;
+                match &self.pool {
+                    Some(p) if p.threads() == k => p.clone(),
+                    _ => {
+                        let p = Arc::new(PoolExec::new(k)?);
+                        self.pool = Some(p.clone());
+                        p
+                    }
+                }
+            }
+            Threading::Split => match &self.split {
+                Some(s) => s.clone(),
+                None => {
+                    let s = Arc::new(SplitExec::new()?);
+                    self.split = Some(s.clone());
+                    s
+                }
+            },
+        })
     }
 }

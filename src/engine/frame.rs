@@ -1,0 +1,59 @@
+//! One frame's worth of work, moved whole to whichever thread runs it: the
+//! world, the model, the executor, and the back snapshot to fill.
+use super::Settings;
+use super::snapshot::{OverlapScratch, Snapshot};
+use crate::physics::{Exec, Model, World};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// An executor that can travel with the frame to the physics thread.
+pub(crate) type SharedExec = Arc<dyn Exec + Send + Sync>;
+
+pub(crate) struct Frame {
+    pub world: World,
+    pub model: Box<dyn Model>,
+    pub exec: SharedExec,
+    pub settings: Settings,
+    pub energy_reset: f64,
+    pub number: u64,
+    pub notice: Option<String>,
+    /// The back buffer: filled here, swapped to the front when done.
+    pub snap: Snapshot,
+    scratch: OverlapScratch,
+}
+
+impl Frame {
+    pub fn new(world: World, model: Box<dyn Model>, exec: SharedExec, settings: Settings) -> Frame {
+        let energy_reset = world.kinetic_energy();
+        let snap = Snapshot::new(&world, settings, energy_reset);
+        Frame {
+            world,
+            model,
+            exec,
+            settings,
+            energy_reset,
+            number: 0,
+            notice: None,
+            snap,
+            scratch: OverlapScratch::default(),
+        }
+    }
+
+    /// Step the world `tick` times and fill the back snapshot.
+    pub fn run(&mut self) {
+        let steps = u64::from(self.settings.tick);
+        let t0 = Instant::now();
+        self.model
+            .advance(&mut self.world, self.settings.dt, steps, &*self.exec);
+        let physics_seconds = t0.elapsed().as_secs_f64();
+        self.number += 1;
+        let snap = &mut self.snap;
+        snap.fill_world(&self.world, &mut self.scratch, &*self.exec);
+        snap.frame = self.number;
+        snap.energy_reset = self.energy_reset;
+        snap.physics_seconds = physics_seconds;
+        snap.steps = steps;
+        snap.settings = self.settings;
+        snap.notice.clone_from(&self.notice);
+    }
+}

@@ -1,0 +1,125 @@
+//! What the screen reads of a finished frame. Two of them exist: the front
+//! one the renderer reads while the physics fills the back one.
+use super::Settings;
+use crate::physics::broad::{Grid, Pair};
+use crate::physics::{Counters, Exec, World};
+
+/// What the screen needs of one sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SphereView {
+    pub pos: [f64; 3],
+    pub radius: f64,
+    pub speed: f64,
+}
+
+/// One finished frame, read by the renderer while the next one computes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Snapshot {
+    pub frame: u64,
+    pub time: f64,
+    pub size: f64,
+    pub spheres: Vec<SphereView>,
+    pub energy: f64,
+    /// Energy right after the last reset (or scene start), for the drift.
+    pub energy_reset: f64,
+    pub max_overlap_rel: f64,
+    pub escaped: usize,
+    pub counters: Counters,
+    /// Wall-clock seconds the physics of this frame took.
+    pub physics_seconds: f64,
+    /// Steps run in this frame.
+    pub steps: u64,
+    /// The settings this frame ran with (what really ran).
+    pub settings: Settings,
+    /// A limit the last count or radius command hit, e.g. "radius limit:
+    /// spheres touch at r = 0.0310"; kept until the next such command.
+    pub notice: Option<String>,
+}
+
+impl Snapshot {
+    pub(crate) fn new(world: &World, settings: Settings, energy_reset: f64) -> Snapshot {
+        let mut s = Snapshot {
+            frame: 0,
+            time: 0.0,
+            size: world.size,
+            spheres: Vec::new(),
+            energy: 0.0,
+            energy_reset,
+            max_overlap_rel: 0.0,
+            escaped: 0,
+            counters: Counters::default(),
+            physics_seconds: 0.0,
+            steps: 0,
+            settings,
+            notice: None,
+        };
+        s.fill_world(
+            world,
+            &mut OverlapScratch::default(),
+            &crate::physics::Serial,
+        );
+        s
+    }
+
+    /// Copy what the screen needs out of `world`, reusing the buffers.
+    pub(crate) fn fill_world(
+        &mut self,
+        world: &World,
+        scratch: &mut OverlapScratch,
+        exec: &dyn Exec,
+    ) {
+        self.time = world.time;
+        self.size = world.size;
+        self.spheres.clear();
+        self.spheres
+            .extend(world.spheres.iter().map(|s| SphereView {
+                pos: s.pos.to_array(),
+                radius: s.radius,
+                speed: s.vel.length(),
+            }));
+        self.energy = world.kinetic_energy();
+        self.max_overlap_rel = scratch.max_overlap_rel(world, exec);
+        self.escaped = world.escaped();
+        self.counters = world.counters;
+    }
+
+    /// `|E - E_reset| / E_reset` (0 for a world at rest).
+    pub fn energy_drift(&self) -> f64 {
+        if self.energy_reset > 0.0 {
+            (self.energy - self.energy_reset).abs() / self.energy_reset
+        } else {
+            0.0
+        }
+    }
+}
+
+/// A grid kept between frames for the overlap check, searched on the
+/// frame's executor (`World::max_overlap_rel` would rebuild it serially).
+#[derive(Default)]
+pub(crate) struct OverlapScratch {
+    grid: Grid,
+    pairs: Vec<Pair>,
+}
+
+impl OverlapScratch {
+    /// Same value as `World::max_overlap_rel`: the max is order-free.
+    fn max_overlap_rel(&mut self, world: &World, exec: &dyn Exec) -> f64 {
+        let sp = &world.spheres;
+        self.grid.build(sp, world.size, |s| (s.pos, s.radius), exec);
+        let overlapping = |i: u32, j: u32| {
+            let (a, b) = (&sp[i as usize], &sp[j as usize]);
+            let s = a.radius + b.radius;
+            a.pos.distance_squared(b.pos) < s * s
+        };
+        self.grid.pairs(exec, &overlapping, &mut self.pairs);
+        self.pairs.iter().fold(0.0, |worst: f64, &(i, j)| {
+            let (a, b) = (&sp[i as usize], &sp[j as usize]);
+            let depth = a.radius + b.radius - a.pos.distance(b.pos);
+            if depth > 0.0 {
+                worst.max(depth / a.radius.min(b.radius))
+            } else {
+                worst
+            }
+        })
+    }
+}
