@@ -39,8 +39,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             println!("{}", serde_json::to_string(&report)?);
             Ok(())
         }
-        Some(Command::Tradeoff(_)) => {
-            Err(BadInput("`ballpit tradeoff` is not built yet".into()).into())
+        Some(Command::Tradeoff(args)) => {
+            let world = scene::build_world(&args.scene.spec())?;
+            ballpit::tradeoff::run(world, args.out.as_deref())
         }
         None => {
             let settings = cli.run.settings()?;
