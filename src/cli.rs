@@ -87,9 +87,10 @@ pub struct RunArgs {
     /// Step length in seconds
     #[arg(long, default_value_t = 1.0 / 60.0, value_name = "DT")]
     pub dt: f64,
-    /// Steps per rendered frame (0 freezes)
-    #[arg(long, default_value_t = 1, value_name = "N")]
-    pub tick: u32,
+    /// Steps per rendered frame (0 freezes); for `bench`, steps per engine
+    /// frame (default: a hundredth of --steps)
+    #[arg(long, value_name = "N")]
+    pub tick: Option<u32>,
     /// Collision model
     #[arg(long, default_value = "swept", value_name = "MODEL")]
     pub model: ModelKind,
@@ -128,7 +129,7 @@ impl RunArgs {
         Ok(Settings {
             model: self.model,
             dt: self.dt,
-            tick: self.tick,
+            tick: self.tick.unwrap_or(1),
             threading: self.threading,
             threads,
         })

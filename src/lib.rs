@@ -8,4 +8,5 @@ pub mod engine;
 pub mod error;
 pub mod physics;
 pub mod scene;
+pub mod tradeoff;
 pub mod tui;

@@ -26,7 +26,11 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Bench(args)) => {
-            let settings = args.run.settings()?;
+            let mut settings = args.run.settings()?;
+            settings.tick = args
+                .run
+                .tick
+                .unwrap_or_else(|| args.steps.div_ceil(100).clamp(1, u64::from(u32::MAX)) as u32);
             let world = scene::build_world(&args.scene.spec())?;
             let (report, world) = bench::run(world, &settings, args.steps)?;
             if let Some(path) = &args.dump {
@@ -35,8 +39,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             println!("{}", serde_json::to_string(&report)?);
             Ok(())
         }
-        Some(Command::Tradeoff(_)) => {
-            Err(BadInput("`ballpit tradeoff` is not built yet".into()).into())
+        Some(Command::Tradeoff(args)) => {
+            let world = scene::build_world(&args.scene.spec())?;
+            ballpit::tradeoff::run(world, args.out.as_deref())
         }
         None => {
             let settings = cli.run.settings()?;

@@ -154,3 +154,50 @@ fn bad_input_exits_2_with_one_clear_message() {
     assert_eq!(out.status.code(), Some(2), "missing --steps");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn bench_runs_every_threading_mode_to_the_same_bits() {
+    let dir = std::env::temp_dir().join(format!("ballpit-modes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut dumps = Vec::new();
+    for (mode, first) in [
+        ("off", "main"),
+        ("worker", "physics"),
+        ("pool", "physics"),
+        ("split", "physics"),
+    ] {
+        let path = dir.join(format!("{mode}.csv"));
+        let v = json(&[
+            "--scene",
+            "dense",
+            "--count",
+            "1500",
+            "--steps",
+            "40",
+            "--tick",
+            "7",
+            "--threading",
+            mode,
+            "--threads",
+            "2",
+            "--dump",
+            path.to_str().unwrap(),
+        ]);
+        assert_eq!(v["threading"], mode);
+        assert_eq!(v["physics_threads"][0], first, "{mode}");
+        assert!(v["sphere_collisions"].as_u64().unwrap() > 0);
+        let names: Vec<&str> = v["thread_cpu"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| t["name"].as_str().unwrap())
+            .collect();
+        assert!(names.contains(&"physics"), "{mode}: {names:?}");
+        dumps.push(std::fs::read(&path).unwrap());
+    }
+    assert!(
+        dumps.windows(2).all(|w| w[0] == w[1]),
+        "threading modes differ"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

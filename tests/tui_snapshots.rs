@@ -98,6 +98,25 @@ fn readouts_panel() {
 }
 
 #[test]
+fn readouts_panel_says_when_the_event_cap_was_hit() {
+    let (st, mut snap, stats) = (state(), snapshot(), stats());
+    snap.counters.capped_steps = 3;
+    let t = render(44, 18, |f| {
+        f.render_widget(
+            Readouts {
+                state: &st,
+                snap: &snap,
+                stats: &stats,
+                palette: Palette::C16,
+            },
+            f.area(),
+        )
+    });
+    let text = format!("{:?}", t.backend().buffer());
+    assert!(text.contains("event cap hit in 3 steps"), "{text}");
+}
+
+#[test]
 fn readouts_panel_paused_in_pool_mode() {
     let (mut st, snap, stats) = (state(), snapshot(), stats());
     st.threading = Threading::Pool;

@@ -5,8 +5,11 @@ use std::fs;
 /// The kernel's clock tick for `stat` times; 100 on every Linux we target.
 const TICKS_PER_SECOND: f64 = 100.0;
 
-/// `(tid, name, cpu_seconds)` for every thread of the process, by tid.
+/// `(tid, name, cpu_seconds)` for every thread of the process, by tid. The
+/// main thread (tid = pid) carries the program's name in the kernel; it is
+/// listed as `main`, the name the article and the screen use for it.
 pub fn read_threads() -> Vec<(i32, String, f64)> {
+    let pid = std::process::id() as i32;
     let Ok(dir) = fs::read_dir("/proc/self/task") else {
         return Vec::new();
     };
@@ -16,7 +19,8 @@ pub fn read_threads() -> Vec<(i32, String, f64)> {
             // A thread may exit between listing and reading: skip it then.
             let secs = thread_cpu_seconds_of(tid)?;
             let name = fs::read_to_string(format!("/proc/self/task/{tid}/comm")).ok()?;
-            Some((tid, name.trim_end().to_string(), secs))
+            let name = if tid == pid { "main" } else { name.trim_end() };
+            Some((tid, name.to_string(), secs))
         })
         .collect();
     out.sort_by_key(|t| t.0);

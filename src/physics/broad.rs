@@ -322,6 +322,12 @@ impl Grid {
                         key: level.key_of(pos),
                     })
                     .collect();
+                if placed.is_empty() {
+                    // Balls wider than a one-cell level (the whole box) fit
+                    // no coarser level either: they join the top, tested
+                    // against everything. Without this the loop never ends.
+                    break;
+                }
                 level.fill(placed.iter().copied(), &mut self.fill);
                 let cell = level.cell;
                 self.rest.retain(|b| 2.0 * b.1 > cell);

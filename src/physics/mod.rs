@@ -4,6 +4,7 @@ pub mod broad;
 pub mod contact;
 pub mod discrete;
 pub mod edit;
+pub mod exact;
 pub mod exec;
 pub mod flight;
 pub mod model;

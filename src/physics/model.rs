@@ -8,15 +8,17 @@ use std::str::FromStr;
 pub enum ModelKind {
     Discrete,
     Swept,
+    Exact,
 }
 
 impl ModelKind {
-    pub const ALL: [ModelKind; 2] = [ModelKind::Discrete, ModelKind::Swept];
+    pub const ALL: [ModelKind; 3] = [ModelKind::Discrete, ModelKind::Swept, ModelKind::Exact];
 
     pub fn name(self) -> &'static str {
         match self {
             ModelKind::Discrete => "discrete",
             ModelKind::Swept => "swept",
+            ModelKind::Exact => "exact",
         }
     }
 
@@ -30,6 +32,7 @@ impl ModelKind {
         match self {
             ModelKind::Discrete => Box::new(super::discrete::Discrete::default()),
             ModelKind::Swept => Box::new(super::swept::Swept::default()),
+            ModelKind::Exact => Box::new(super::exact::Exact::default()),
         }
     }
 }

@@ -113,6 +113,12 @@ impl Readouts<'_> {
             )));
         } else if let Some(n) = &s.notice {
             lines.push(Line::from(Span::styled(n.clone(), self.palette.alert())));
+        } else if snap.counters.capped_steps > 0 {
+            // A capped step skipped contacts: say so, it explains overlaps.
+            lines.push(Line::from(Span::styled(
+                format!(" event cap hit in {} steps ", snap.counters.capped_steps),
+                self.palette.alert(),
+            )));
         } else {
             lines.push(Line::from(""));
         }

@@ -1,0 +1,116 @@
+//! Predicting a sphere's next event: the earliest of a contact with one of its
+//! candidate partners, a wall contact, or a broad-phase event (leaving its
+//! neighbour-list skin, or crossing into another cell). Only that earliest
+//! event is kept (one per sphere, as Smallenburg's EDMD does); a contact
+//! stays valid while the partner's collision count is unchanged, and is
+//! recomputed when it comes due otherwise.
+use super::body::Body;
+use crate::physics::contact::{pair_toi, wall_toi};
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Kind {
+    /// Nothing will ever happen to this sphere (it stands still).
+    #[default]
+    Idle,
+    /// Contact with `partner`, valid while its count is `partner_count`.
+    Pair,
+    /// Contact with the walls of the axes in `mask` (bits 0..3).
+    Wall,
+    /// The sphere reaches the edge of its skin: rebuild its neighbour list
+    /// (or, for a large sphere in cell mode, its scan of the cells).
+    Relist,
+    /// The centre crosses into the next cell along axis `mask & 3`, upwards
+    /// if `mask & 4`.
+    Cross,
+}
+
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Event {
+    pub kind: Kind,
+    pub mask: u8,
+    pub partner: u32,
+    pub partner_count: u32,
+}
+
+/// The running earliest event of sphere `a` (already moved to `now = a.t`).
+/// Ties keep the first found: the broad-phase event, then walls, then
+/// partners in the order offered.
+pub struct Predictor<'a> {
+    a: Body,
+    bodies: &'a [Body],
+    counts: &'a [u32],
+    best: f64,
+    ev: Event,
+}
+
+impl<'a> Predictor<'a> {
+    /// Start from the broad-phase event `(in_t, ev)` (relative time) and the walls.
+    #[inline]
+    pub fn new(
+        a: &Body,
+        bodies: &'a [Body],
+        counts: &'a [u32],
+        size: f64,
+        in_t: f64,
+        ev: Event,
+    ) -> Self {
+        let mut p = Predictor {
+            a: *a,
+            bodies,
+            counts,
+            best: in_t,
+            ev: if in_t.is_finite() {
+                ev
+            } else {
+                Event::default()
+            },
+        };
+        let (tw, mask) = wall_toi(&a.sphere(0.0), size);
+        if tw < p.best {
+            p.best = tw;
+            p.ev = Event {
+                kind: Kind::Wall,
+                mask: mask[0] as u8 | (mask[1] as u8) << 1 | (mask[2] as u8) << 2,
+                ..Event::default()
+            };
+        }
+        p
+    }
+
+    /// Consider a contact with sphere `j`.
+    #[inline(always)]
+    pub fn pair(&mut self, j: u32) {
+        let a = &self.a;
+        let b = &self.bodies[j as usize];
+        let dp = a.pos - b.pos_at(a.t);
+        let dv = a.vel - b.vel;
+        let bb = dp.dot(dv);
+        if bb >= 0.0 {
+            return;
+        }
+        let sigma = a.radius + b.radius;
+        let c = dp.length_squared() - sigma * sigma;
+        // The root is at least c / (-2 bb): skip pairs that cannot beat
+        // `best` without taking a square root.
+        if c > -2.0 * bb * self.best {
+            return;
+        }
+        if let Some(t) = pair_toi(dp, dv, sigma)
+            && t < self.best
+        {
+            self.best = t;
+            self.ev = Event {
+                kind: Kind::Pair,
+                mask: 0,
+                partner: j,
+                partner_count: self.counts[j as usize],
+            };
+        }
+    }
+
+    /// The absolute event time and the event.
+    #[inline]
+    pub fn finish(self) -> (f64, Event) {
+        (self.a.t + self.best, self.ev)
+    }
+}

@@ -1,0 +1,268 @@
+//! `ballpit tradeoff`: every model over a ladder of `dt`, measured against the
+//! exact model on the same scene. All models run on one thread here, so the
+//! costs compare algorithms, not thread counts.
+//!
+//! Measures, per model and `dt`, over [`RUN_SECONDS`] of simulated time:
+//! cost (wall seconds per simulated second, sphere-steps per second), worst
+//! relative energy error, deepest overlap (per smaller radius, worst over
+//! the steps), spheres escaped (worst over the steps), and sphere–sphere
+//! collisions missed relative to `exact` over the same time. Then the
+//! position error against `exact` at a short horizon: a quarter of the mean
+//! free time (from the exact run), rounded up to whole steps. Before that
+//! time a typical sphere has not collided yet, so the difference comes from
+//! how the model handles the few contacts that do happen, not from chaos:
+//! each collision multiplies a small position difference by about the mean
+//! free path over the diameter, so after a few collisions per sphere any two
+//! runs (even `exact` against itself with another `dt`) differ by the box.
+use crate::physics::{ModelKind, Serial, World};
+use anyhow::Context;
+use plotters::prelude::*;
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::Instant;
+
+/// The `dt` ladder: 1/15 s down to 1/1920 s, halving.
+pub const LADDER: [f64; 8] = [
+    1.0 / 15.0,
+    1.0 / 30.0,
+    1.0 / 60.0,
+    1.0 / 120.0,
+    1.0 / 240.0,
+    1.0 / 480.0,
+    1.0 / 960.0,
+    1.0 / 1920.0,
+];
+/// Simulated seconds each (model, dt) runs for the cost and error figures.
+pub const RUN_SECONDS: f64 = 2.0;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    pub model: ModelKind,
+    pub dt: f64,
+    pub steps: u64,
+    /// Wall seconds per simulated second.
+    pub cost: f64,
+    pub sphere_steps_per_second: f64,
+    pub energy_err: f64,
+    pub max_overlap_rel: f64,
+    pub escaped: usize,
+    pub collisions: u64,
+    /// `1 - collisions / exact collisions` (negative: counted more than exact).
+    pub missed: f64,
+    pub horizon: f64,
+    /// RMS distance to the exact positions at `horizon`, in box lengths.
+    pub pos_err: f64,
+    pub capped_steps: u64,
+}
+
+/// Measure every model over the ladder on `world`.
+pub fn measure(world: &World) -> Vec<Row> {
+    let reference = {
+        let mut w = world.clone();
+        let mut m = ModelKind::Exact.build();
+        let steps = (RUN_SECONDS * 60.0).round() as u64;
+        m.advance(&mut w, RUN_SECONDS / steps as f64, steps, &Serial);
+        w.counters.sphere_collisions
+    };
+    let n = world.spheres.len();
+    let free_time = if reference > 0 {
+        n as f64 * RUN_SECONDS / (2.0 * reference as f64)
+    } else {
+        f64::INFINITY
+    };
+    let horizon = (free_time / 4.0).min(RUN_SECONDS / 8.0);
+    let mut rows = Vec::new();
+    for model in ModelKind::ALL {
+        for dt in LADDER {
+            let mut row = run_one(world, model, dt);
+            row.missed = if reference > 0 {
+                1.0 - row.collisions as f64 / reference as f64
+            } else {
+                0.0
+            };
+            let steps_h = (horizon / dt).ceil().max(1.0) as u64;
+            row.pos_err = position_error(world, model, dt, steps_h);
+            row.horizon = steps_h as f64 * dt;
+            rows.push(row);
+        }
+    }
+    rows
+}
+
+fn run_one(world: &World, kind: ModelKind, dt: f64) -> Row {
+    let mut w = world.clone();
+    let mut model = kind.build();
+    let steps = (RUN_SECONDS / dt).round() as u64;
+    let e0 = w.kinetic_energy();
+    let (mut energy_err, mut overlap, mut escaped) = (0.0f64, w.max_overlap_rel(), w.escaped());
+    let mut wall = 0.0;
+    for _ in 0..steps {
+        let t = Instant::now();
+        model.advance(&mut w, dt, 1, &Serial);
+        wall += t.elapsed().as_secs_f64();
+        if e0 > 0.0 {
+            energy_err = energy_err.max((w.kinetic_energy() - e0).abs() / e0);
+        }
+        overlap = overlap.max(w.max_overlap_rel());
+        escaped = escaped.max(w.escaped());
+    }
+    Row {
+        model: kind,
+        dt,
+        steps,
+        cost: wall / (steps as f64 * dt),
+        sphere_steps_per_second: if wall > 0.0 {
+            (steps * w.spheres.len() as u64) as f64 / wall
+        } else {
+            0.0
+        },
+        energy_err,
+        max_overlap_rel: overlap,
+        escaped,
+        collisions: w.counters.sphere_collisions,
+        missed: 0.0,
+        horizon: 0.0,
+        pos_err: 0.0,
+        capped_steps: w.counters.capped_steps,
+    }
+}
+
+fn position_error(world: &World, kind: ModelKind, dt: f64, steps: u64) -> f64 {
+    let run = |k: ModelKind| {
+        let mut w = world.clone();
+        k.build().advance(&mut w, dt, steps, &Serial);
+        w
+    };
+    let (a, b) = (run(kind), run(ModelKind::Exact));
+    if a.spheres.is_empty() {
+        return 0.0;
+    }
+    let sum: f64 = a
+        .spheres
+        .iter()
+        .zip(&b.spheres)
+        .map(|(x, y)| x.pos.distance_squared(y.pos))
+        .sum();
+    (sum / a.spheres.len() as f64).sqrt() / world.size
+}
+
+fn dt_label(dt: f64) -> String {
+    format!("1/{}", (1.0 / dt).round())
+}
+
+pub fn markdown(rows: &[Row]) -> String {
+    let mut s = String::from(
+        "| model | dt | wall s / sim s | sphere-steps/s | energy err | deepest overlap (r) | escaped | collisions missed | pos err (L) at horizon |\n\
+         |---|---|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.2e} | {:.2e} | {:.1e} | {:.1e} | {} | {:+.1} % | {:.1e} at {:.3} s |",
+            r.model,
+            dt_label(r.dt),
+            r.cost,
+            r.sphere_steps_per_second,
+            r.energy_err,
+            r.max_overlap_rel,
+            r.escaped,
+            100.0 * r.missed,
+            r.pos_err,
+            r.horizon,
+        );
+    }
+    s
+}
+
+pub fn csv(rows: &[Row]) -> String {
+    let mut s = String::from(
+        "model,dt,steps,wall_s_per_sim_s,sphere_steps_per_second,energy_err_rel,max_overlap_rel,escaped,sphere_collisions,missed_rel,horizon_s,pos_err_rms,capped_steps\n",
+    );
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "{},{:e},{},{:e},{:e},{:e},{:e},{},{},{:e},{:e},{:e},{}",
+            r.model,
+            r.dt,
+            r.steps,
+            r.cost,
+            r.sphere_steps_per_second,
+            r.energy_err,
+            r.max_overlap_rel,
+            r.escaped,
+            r.collisions,
+            r.missed,
+            r.horizon,
+            r.pos_err,
+            r.capped_steps,
+        );
+    }
+    s
+}
+
+/// Position error against cost, log–log, a line per model (errors below
+/// `1e-16` drawn at `1e-16`: rounding).
+pub fn svg(rows: &[Row], path: &Path) -> anyhow::Result<()> {
+    let floor = 1e-16;
+    let xs = rows.iter().map(|r| r.cost.max(1e-9));
+    let (xmin, xmax) = xs.fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)));
+    let ys = rows.iter().map(|r| r.pos_err.max(floor));
+    let (ymin, ymax) = ys.fold((f64::INFINITY, 0.0f64), |(a, b), y| (a.min(y), b.max(y)));
+    let root = SVGBackend::new(path, (800, 560)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            "ballpit tradeoff: position error vs cost",
+            ("sans-serif", 22),
+        )
+        .margin(16)
+        .x_label_area_size(48)
+        .y_label_area_size(72)
+        .build_cartesian_2d(
+            (xmin / 2.0..xmax * 2.0).log_scale(),
+            (ymin / 10.0..ymax * 10.0).log_scale(),
+        )?;
+    chart
+        .configure_mesh()
+        .x_desc("wall seconds per simulated second (one thread)")
+        .y_desc("RMS position error at horizon (box lengths)")
+        .x_label_formatter(&|x| format!("{x:.0e}"))
+        .y_label_formatter(&|y| format!("{y:.0e}"))
+        .draw()?;
+    let colours = [RED, BLUE, GREEN, MAGENTA, CYAN];
+    for (k, model) in ModelKind::ALL.iter().enumerate() {
+        let colour = colours[k % colours.len()];
+        let pts: Vec<(f64, f64)> = rows
+            .iter()
+            .filter(|r| r.model == *model)
+            .map(|r| (r.cost.max(1e-9), r.pos_err.max(floor)))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))?
+            .label(model.name())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
+        chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, colour.filled())))?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
+
+/// Measure, print the table, and with `out` write `tradeoff.csv` and
+/// `tradeoff.svg` there.
+pub fn run(world: World, out: Option<&Path>) -> anyhow::Result<()> {
+    let rows = measure(&world);
+    print!("{}", markdown(&rows));
+    if let Some(dir) = out {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        let csv_path = dir.join("tradeoff.csv");
+        std::fs::write(&csv_path, csv(&rows))
+            .with_context(|| format!("cannot write {}", csv_path.display()))?;
+        svg(&rows, &dir.join("tradeoff.svg"))?;
+    }
+    Ok(())
+}
