@@ -6,7 +6,7 @@
 //! the finer levels by querying their cells over its own reach, so radii or
 //! speeds spread over orders of magnitude stay about linear in cost. Tiny
 //! scenes use all pairs.
-use super::exec::{Exec, for_each_block};
+use super::exec::{Exec, for_each_block, for_each_chunk};
 use super::sphere::Sphere;
 use glam::DVec3;
 use parking_lot::Mutex;
@@ -245,16 +245,11 @@ impl Grid {
         let n = spheres.len();
         self.top.clear();
         self.balls.resize(n, (DVec3::ZERO, 0.0));
-        {
-            let chunks: Vec<Mutex<&mut [(DVec3, f64)]>> =
-                self.balls.chunks_mut(BUILD_BLOCK).map(Mutex::new).collect();
-            for_each_block(exec, chunks.len(), &|b| {
-                let mut chunk = chunks[b].lock();
-                for (slot, s) in chunk.iter_mut().zip(&spheres[b * BUILD_BLOCK..]) {
-                    *slot = ball(s);
-                }
-            });
-        }
+        for_each_chunk(exec, &mut self.balls, BUILD_BLOCK, &|b, chunk| {
+            for (slot, s) in chunk.iter_mut().zip(&spheres[b * BUILD_BLOCK..]) {
+                *slot = ball(s);
+            }
+        });
         let mut depth = 0;
         if n > ALL_PAIRS_MAX {
             // First level: keys in parallel, the sort serial.
@@ -268,10 +263,7 @@ impl Grid {
             {
                 let level = &*level;
                 let balls = &self.balls;
-                let chunks: Vec<Mutex<&mut [u32]>> =
-                    self.keys.chunks_mut(BUILD_BLOCK).map(Mutex::new).collect();
-                for_each_block(exec, chunks.len(), &|b| {
-                    let mut chunk = chunks[b].lock();
+                for_each_chunk(exec, &mut self.keys, BUILD_BLOCK, &|b, chunk| {
                     for (slot, &(pos, r)) in chunk.iter_mut().zip(&balls[b * BUILD_BLOCK..]) {
                         *slot = if level.fits(r) {
                             level.key_of(pos)

@@ -6,7 +6,7 @@
 //! before the wall mirror.
 use super::broad::{Grid, Pair};
 use super::contact::resolve_pair;
-use super::exec::{Exec, for_each_block};
+use super::exec::{Exec, for_each_block, for_each_chunk};
 use super::model::{Model, ModelKind};
 use super::sphere::Sphere;
 use super::swept::{SPHERE_BLOCK, pair_mut};
@@ -42,18 +42,11 @@ impl Discrete {
         while self.walls.len() < blocks {
             self.walls.push(Mutex::new(Vec::new()));
         }
-        {
-            let chunks: Vec<Mutex<&mut [Sphere]>> = world
-                .spheres
-                .chunks_mut(SPHERE_BLOCK)
-                .map(Mutex::new)
-                .collect();
-            for_each_block(exec, blocks, &|b| {
-                for s in chunks[b].lock().iter_mut() {
-                    s.pos += s.vel * dt;
-                }
-            });
-        }
+        for_each_chunk(exec, &mut world.spheres, SPHERE_BLOCK, &|_, chunk| {
+            for s in chunk {
+                s.pos += s.vel * dt;
+            }
+        });
         let sp = &world.spheres;
         let overlapping = |i: u32, j: u32| {
             let (a, b) = (&sp[i as usize], &sp[j as usize]);

@@ -100,7 +100,8 @@ pub fn add_spheres(
     placed
 }
 
-fn random_direction(rng: &mut impl Rng) -> DVec3 {
+/// A uniformly random unit vector.
+pub fn random_direction(rng: &mut impl Rng) -> DVec3 {
     loop {
         let v = DVec3::new(
             rng.sample(StandardNormal),

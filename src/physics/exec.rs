@@ -43,6 +43,21 @@ pub fn lane_blocks(blocks: usize, lane: usize, lanes: usize) -> std::ops::Range<
     start..(start + per).min(blocks)
 }
 
+/// Run `f(block, chunk)` for `data` cut into chunks of `block` items, the
+/// chunks spread over lanes.
+pub fn for_each_chunk<T: Send>(
+    exec: &dyn Exec,
+    data: &mut [T],
+    block: usize,
+    f: &(dyn Fn(usize, &mut [T]) + Sync),
+) {
+    let chunks: Vec<parking_lot::Mutex<&mut [T]>> = data
+        .chunks_mut(block)
+        .map(parking_lot::Mutex::new)
+        .collect();
+    for_each_block(exec, chunks.len(), &|b| f(b, &mut chunks[b].lock()));
+}
+
 /// Run `f(block)` for every block in `0..blocks`, blocks spread over lanes.
 pub fn for_each_block(exec: &dyn Exec, blocks: usize, f: &(dyn Fn(usize) + Sync)) {
     let lanes = exec.lanes().min(blocks).max(1);

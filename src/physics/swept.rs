@@ -8,7 +8,7 @@
 //! in free flight and counted in `capped_steps`.
 use super::broad::{Grid, Pair};
 use super::contact::{pair_toi, reflect_walls, resolve_pair, wall_toi};
-use super::exec::{Exec, for_each_block};
+use super::exec::{Exec, for_each_block, for_each_chunk};
 use super::flight::fly;
 use super::model::{Model, ModelKind};
 use super::sphere::Sphere;
@@ -148,13 +148,8 @@ impl Swept {
         self.events(world, dt, blocks);
         // Everyone without an event flies straight and meets no wall.
         let local = &self.local;
-        let chunks: Vec<Mutex<&mut [Sphere]>> = world
-            .spheres
-            .chunks_mut(SPHERE_BLOCK)
-            .map(Mutex::new)
-            .collect();
-        for_each_block(exec, blocks, &|b| {
-            for (k, s) in chunks[b].lock().iter_mut().enumerate() {
+        for_each_chunk(exec, &mut world.spheres, SPHERE_BLOCK, &|b, chunk| {
+            for (k, s) in chunk.iter_mut().enumerate() {
                 if local[b * SPHERE_BLOCK + k] == NONE {
                     s.pos += s.vel * dt;
                 }

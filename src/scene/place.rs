@@ -2,6 +2,7 @@
 use super::presets::{Layout, Preset};
 use crate::bad;
 use crate::error::BadInput;
+use crate::physics::edit::random_direction;
 use crate::physics::sphere::volume;
 use crate::physics::{Sphere, World};
 use glam::DVec3;
@@ -55,20 +56,6 @@ pub fn generate(
         _ => maxwell(&mut spheres, speed, rng),
     }
     Ok(World::new(size, spheres))
-}
-
-pub fn random_direction(rng: &mut SceneRng) -> DVec3 {
-    loop {
-        let v = DVec3::new(
-            rng.sample(StandardNormal),
-            rng.sample(StandardNormal),
-            rng.sample(StandardNormal),
-        );
-        let len = v.length();
-        if len > 1e-9 {
-            return v / len;
-        }
-    }
 }
 
 /// Gaussian components, no net momentum, rescaled to rms speed `speed`.
