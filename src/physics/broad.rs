@@ -62,7 +62,6 @@ pub struct Grid {
     /// Spheres not yet placed in a level: (ball, id).
     rest: Vec<(DVec3, f64, u32)>,
     scratch: Vec<f64>,
-    fill: Vec<u32>,
     slots: Vec<Mutex<Vec<Pair>>>,
 }
 
@@ -122,23 +121,27 @@ impl Level {
     }
 
     /// Counting sort of `items` (ball, id, key), stable.
-    fn fill(&mut self, items: impl Iterator<Item = Entry> + Clone, fill: &mut Vec<u32>) {
+    /// Counting sort of `items`, stable, in place: counts go to
+    /// `cell_start[key]`, inclusive prefix sums make that the end of each
+    /// cell, and placing the items in reverse order walks each end down to
+    /// the cell's start.
+    fn fill(&mut self, items: impl DoubleEndedIterator<Item = Entry> + Clone) {
         for e in items.clone() {
             self.reach_max = self.reach_max.max(e.reach);
-            self.cell_start[e.key as usize + 1] += 1;
+            self.cell_start[e.key as usize] += 1;
         }
         let cells = self.cell_start.len() - 1;
-        for c in 0..cells {
-            self.cell_start[c + 1] += self.cell_start[c];
+        let mut sum = 0;
+        for c in &mut self.cell_start[..cells] {
+            sum += *c;
+            *c = sum;
         }
-        self.entries
-            .resize(self.cell_start[cells] as usize, Entry::default());
-        fill.clear();
-        fill.extend_from_slice(&self.cell_start[..cells]);
-        for e in items {
-            let slot = &mut fill[e.key as usize];
+        self.cell_start[cells] = sum;
+        self.entries.resize(sum as usize, Entry::default());
+        for e in items.rev() {
+            let slot = &mut self.cell_start[e.key as usize];
+            *slot -= 1;
             self.entries[*slot as usize] = e;
-            *slot += 1;
         }
     }
 
@@ -285,7 +288,7 @@ impl Grid {
                     id: i as u32,
                     key,
                 });
-            level.fill(placed, &mut self.fill);
+            level.fill(placed);
             self.rest.clear();
             self.rest.extend(
                 keys.iter()
@@ -320,7 +323,7 @@ impl Grid {
                     // against everything. Without this the loop never ends.
                     break;
                 }
-                level.fill(placed.iter().copied(), &mut self.fill);
+                level.fill(placed.iter().copied());
                 let cell = level.cell;
                 self.rest.retain(|b| 2.0 * b.1 > cell);
                 depth += 1;
