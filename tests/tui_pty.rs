@@ -148,7 +148,7 @@ fn thread_loads(screen: &str) -> Vec<(String, f64)> {
 #[test]
 fn readouts_threading_tick_and_quit_in_a_real_terminal() {
     // A tick high enough that the physics, not the drawing, is the load.
-    let mut app = start(&["--tick", "40"], None);
+    let mut app = start(&["--tick", "120"], None);
     let s = app.wait_for("the readouts", 10.0, |s| {
         s.contains("threading") && s.contains("fps") && s.contains("physics")
     });
@@ -159,7 +159,7 @@ fn readouts_threading_tick_and_quit_in_a_real_terminal() {
         "{s}"
     );
     assert_eq!(
-        readout(&s, "tick").map(|v| v.starts_with("40 ")),
+        readout(&s, "tick").map(|v| v.starts_with("120 ")),
         Some(true),
         "{s}"
     );
@@ -194,8 +194,8 @@ fn readouts_threading_tick_and_quit_in_a_real_terminal() {
     assert!((10.0..=31.5).contains(&fps), "fps {fps}\n{s}");
     // `]` raises the tick on screen.
     app.send("]");
-    app.wait_for("tick 41", 3.0, |s| {
-        readout(s, "tick").is_some_and(|v| v.starts_with("41 "))
+    app.wait_for("tick 121", 3.0, |s| {
+        readout(s, "tick").is_some_and(|v| v.starts_with("121 "))
     });
     app.send("q");
     let st = app.wait_exit(3.0).expect("q ends the app");
