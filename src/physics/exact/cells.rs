@@ -12,21 +12,18 @@
 //! the skin (a small sphere entering that reach does so by a crossing, which
 //! checks the large ones).
 use super::body::Body;
+use super::cell_list::{CellList, NONE, split_big};
 use super::schedule::{Event, Kind};
 use glam::DVec3;
 
-const NONE: u32 = u32::MAX;
 const BIG_FACTOR: f64 = 3.0;
 
 #[derive(Clone, Debug, Default)]
 pub struct Cells {
     per_side: usize,
     cell: f64,
-    head: Vec<u32>,
-    next: Vec<u32>,
-    prev: Vec<u32>,
-    /// Cell of each sphere, `NONE` for large ones.
-    cell_of: Vec<u32>,
+    /// The small spheres of each cell; large ones are in no cell.
+    list: CellList,
     bigs: Vec<u32>,
     /// Where each large sphere last scanned from (indexed like `bigs`).
     scan_centre: Vec<DVec3>,
@@ -38,35 +35,17 @@ pub struct Cells {
 impl Cells {
     pub fn build(&mut self, bodies: &[Body], size: f64) {
         let n = bodies.len();
-        self.next.clear();
-        self.next.resize(n, NONE);
-        self.prev.clear();
-        self.prev.resize(n, NONE);
-        self.cell_of.clear();
-        self.cell_of.resize(n, NONE);
+        self.list.reset(n, 0);
         self.big_slot.clear();
         self.big_slot.resize(n, NONE);
         self.bigs.clear();
         self.scan_centre.clear();
         if n == 0 {
-            self.head.clear();
             self.per_side = 1;
             return;
         }
-        let mut radii: Vec<f64> = bodies.iter().map(|b| b.radius).collect();
-        let k = (n * 98 / 100).min(n - 1);
-        let bulk = *radii.select_nth_unstable_by(k, f64::total_cmp).1;
-        let rmax = radii.iter().copied().fold(0.0, f64::max);
-        let big_above = if rmax <= BIG_FACTOR * bulk {
-            f64::INFINITY
-        } else {
-            BIG_FACTOR * bulk
-        };
-        self.small_rmax = bodies
-            .iter()
-            .map(|b| b.radius)
-            .filter(|&r| r <= big_above)
-            .fold(0.0, f64::max);
+        let big_above;
+        (big_above, self.small_rmax) = split_big(bodies, BIG_FACTOR);
         // A little over a diameter, so rounding at a crossing can never
         // leave touching spheres two cells apart.
         let cell_min = 2.0 * self.small_rmax * (1.0 + 1e-9);
@@ -74,8 +53,7 @@ impl Cells {
         self.per_side = (size / cell_min).floor().clamp(1.0, cap) as usize;
         self.cell = size / self.per_side as f64;
         self.skin = self.cell;
-        self.head.clear();
-        self.head.resize(self.per_side.pow(3), NONE);
+        self.list.reset(n, self.per_side.pow(3));
         for (i, b) in bodies.iter().enumerate() {
             if b.radius > big_above {
                 self.big_slot[i] = self.bigs.len() as u32;
@@ -83,7 +61,7 @@ impl Cells {
                 self.scan_centre.push(b.pos);
             } else {
                 let c = self.coords(b.pos);
-                self.insert(i, self.index(c));
+                self.list.insert(i, self.index(c));
             }
         }
     }
@@ -122,7 +100,7 @@ impl Cells {
             };
             return (t, ev);
         }
-        let c = self.cell_of[i] as usize;
+        let c = self.list.cell(i) as usize;
         let p = self.per_side;
         let coord = [c % p, (c / p) % p, c / (p * p)];
         let mut best = f64::INFINITY;
@@ -155,14 +133,13 @@ impl Cells {
     pub fn cross(&mut self, i: usize, mask: u8) {
         let p = self.per_side;
         let stride = [1, p, p * p][(mask & 3) as usize];
-        let c = self.cell_of[i] as usize;
+        let c = self.list.cell(i) as usize;
         let to = if mask & 4 != 0 {
             c + stride
         } else {
             c - stride
         };
-        self.remove(i);
-        self.insert(i, to);
+        self.list.move_to(i, to);
     }
 
     /// A large sphere rescans from where it is now.
@@ -181,7 +158,7 @@ impl Cells {
             let reach = DVec3::splat((b.radius + self.small_rmax + self.skin) * (1.0 + 1e-9));
             (self.coords(centre - reach), self.coords(centre + reach))
         } else {
-            let c = self.cell_of[i] as usize;
+            let c = self.list.cell(i) as usize;
             let coord = [c % p, (c / p) % p, c / (p * p)];
             let m = p - 1;
             (
@@ -193,13 +170,11 @@ impl Cells {
             for y in lo[1]..=hi[1] {
                 let row = p * (y + p * z);
                 for x in lo[0]..=hi[0] {
-                    let mut j = self.head[row + x];
-                    while j != NONE {
+                    self.list.for_each_in(row + x, |j| {
                         if j as usize != i {
                             f(j);
                         }
-                        j = self.next[j as usize];
-                    }
+                    });
                 }
             }
         }
@@ -217,7 +192,7 @@ impl Cells {
     #[inline]
     pub fn for_each_new_candidate(&self, i: usize, mask: u8, mut f: impl FnMut(u32)) {
         let p = self.per_side;
-        let c = self.cell_of[i] as usize;
+        let c = self.list.cell(i) as usize;
         let mut lo = [c % p, (c / p) % p, c / (p * p)];
         let axis = (mask & 3) as usize;
         let layer = if mask & 4 != 0 {
@@ -239,11 +214,7 @@ impl Cells {
             for y in lo[1]..=hi[1] {
                 let row = p * (y + p * z);
                 for x in lo[0]..=hi[0] {
-                    let mut j = self.head[row + x];
-                    while j != NONE {
-                        f(j);
-                        j = self.next[j as usize];
-                    }
+                    self.list.for_each_in(row + x, &mut f);
                 }
             }
         }
@@ -257,27 +228,5 @@ impl Cells {
 
     fn index(&self, c: [usize; 3]) -> usize {
         c[0] + self.per_side * (c[1] + self.per_side * c[2])
-    }
-
-    fn insert(&mut self, i: usize, c: usize) {
-        self.cell_of[i] = c as u32;
-        self.prev[i] = NONE;
-        self.next[i] = self.head[c];
-        if self.head[c] != NONE {
-            self.prev[self.head[c] as usize] = i as u32;
-        }
-        self.head[c] = i as u32;
-    }
-
-    fn remove(&mut self, i: usize) {
-        let (p, n) = (self.prev[i], self.next[i]);
-        if p != NONE {
-            self.next[p as usize] = n;
-        } else {
-            self.head[self.cell_of[i] as usize] = n;
-        }
-        if n != NONE {
-            self.prev[n as usize] = p;
-        }
     }
 }

@@ -37,6 +37,7 @@
 //! (contacts in its remainder are missed, so overlaps may then appear), and
 //! the schedule is rebuilt for the next step.
 pub mod body;
+pub mod cell_list;
 pub mod cells;
 pub mod lattice;
 pub mod neighbours;

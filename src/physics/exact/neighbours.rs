@@ -17,7 +17,7 @@
 use super::body::Body;
 use glam::DVec3;
 
-const NONE: u32 = u32::MAX;
+use super::cell_list::{CellList, NONE, split_big};
 /// A sphere counts as large (second level) above this multiple of the bulk radius.
 const BIG_FACTOR: f64 = 3.0;
 /// Skin as a fraction of the bulk radius, at least: a quarter diameter
@@ -177,12 +177,8 @@ pub struct Neighbours {
     lists: Lists,
     per_side: usize,
     inv_cell: f64,
-    /// Intrusive doubly linked list of the spheres in each cell, by centre.
-    head: Vec<u32>,
-    next: Vec<u32>,
-    prev: Vec<u32>,
-    /// The cell of each sphere, or `NONE` for second-level spheres.
-    cell: Vec<u32>,
+    /// The spheres of each cell, by centre; second-level ones are in none.
+    cells: CellList,
     bigs: Vec<u32>,
     small_rmax: f64,
 }
@@ -198,30 +194,15 @@ impl Neighbours {
         }));
         self.lists.reset(n);
         self.bigs.clear();
-        self.next.clear();
-        self.next.resize(n, NONE);
-        self.prev.clear();
-        self.prev.resize(n, NONE);
-        self.cell.clear();
-        self.cell.resize(n, NONE);
+        self.cells.reset(n, 0);
         if n == 0 {
-            self.head.clear();
             return;
         }
         let mut radii: Vec<f64> = bodies.iter().map(|b| b.radius).collect();
         let k = (n * 98 / 100).min(n - 1);
         let bulk = *radii.select_nth_unstable_by(k, f64::total_cmp).1;
-        let rmax = radii.iter().copied().fold(0.0, f64::max);
-        let big_above = if rmax <= BIG_FACTOR * bulk {
-            f64::INFINITY
-        } else {
-            BIG_FACTOR * bulk
-        };
-        self.small_rmax = bodies
-            .iter()
-            .map(|b| b.radius)
-            .filter(|&r| r <= big_above)
-            .fold(0.0, f64::max);
+        let big_above;
+        (big_above, self.small_rmax) = split_big(bodies, BIG_FACTOR);
         // Ideal-gas estimate of the distance that holds TARGET_NEIGHBOURS.
         let density = n as f64 / (size * size * size);
         let reach = (TARGET_NEIGHBOURS / (density * 4.0 / 3.0 * std::f64::consts::PI)).cbrt();
@@ -236,14 +217,13 @@ impl Neighbours {
         // Cells larger than needed (few or tiny spheres): widen the skin to
         // fill them, which costs no more per rebuild and rebuilds less often.
         self.skin = (0.5 * size / self.per_side as f64 - self.small_rmax).max(skin);
-        self.head.clear();
-        self.head.resize(self.per_side.pow(3), NONE);
+        self.cells.reset(n, self.per_side.pow(3));
         for (i, b) in bodies.iter().enumerate() {
             if b.radius > big_above {
                 self.bigs.push(i as u32);
                 self.lists.make_big(i);
             } else {
-                self.insert(i, self.cell_index(b.pos));
+                self.cells.insert(i, self.cell_index(b.pos));
             }
         }
         for i in 0..n {
@@ -255,9 +235,8 @@ impl Neighbours {
     pub fn rebuild(&mut self, i: usize, bodies: &[Body]) {
         self.lists.unlink_all(i);
         self.centre[i].pos = bodies[i].pos;
-        if self.cell[i] != NONE {
-            self.remove(i);
-            self.insert(i, self.cell_index(bodies[i].pos));
+        if self.cells.cell(i) != NONE {
+            self.cells.move_to(i, self.cell_index(bodies[i].pos));
         }
         self.scan(i, bodies, |j| j != i);
     }
@@ -305,12 +284,12 @@ impl Neighbours {
                 lists.link(i, j);
             }
         };
-        let reach = if self.cell[i] == NONE {
+        let reach = if self.cells.cell(i) == NONE {
             bodies[i].radius + self.small_rmax + 2.0 * self.skin
         } else {
             0.0
         };
-        let (lo, hi) = if self.cell[i] == NONE {
+        let (lo, hi) = if self.cells.cell(i) == NONE {
             (
                 self.coords(ci - DVec3::splat(reach)),
                 self.coords(ci + DVec3::splat(reach)),
@@ -324,11 +303,9 @@ impl Neighbours {
         for z in lo[2]..=hi[2] {
             for y in lo[1]..=hi[1] {
                 for x in lo[0]..=hi[0] {
-                    let mut j = self.head[x + p * (y + p * z)];
-                    while j != NONE {
-                        test(j as usize, &self.centre, &mut self.lists);
-                        j = self.next[j as usize];
-                    }
+                    self.cells.for_each_in(x + p * (y + p * z), |j| {
+                        test(j as usize, &self.centre, &mut self.lists)
+                    });
                 }
             }
         }
@@ -346,27 +323,5 @@ impl Neighbours {
     fn cell_index(&self, p: DVec3) -> usize {
         let [x, y, z] = self.coords(p);
         x + self.per_side * (y + self.per_side * z)
-    }
-
-    fn insert(&mut self, i: usize, c: usize) {
-        self.cell[i] = c as u32;
-        self.prev[i] = NONE;
-        self.next[i] = self.head[c];
-        if self.head[c] != NONE {
-            self.prev[self.head[c] as usize] = i as u32;
-        }
-        self.head[c] = i as u32;
-    }
-
-    fn remove(&mut self, i: usize) {
-        let (p, n) = (self.prev[i], self.next[i]);
-        if p != NONE {
-            self.next[p as usize] = n;
-        } else {
-            self.head[self.cell[i] as usize] = n;
-        }
-        if n != NONE {
-            self.prev[n as usize] = p;
-        }
     }
 }

@@ -1,0 +1,91 @@
+//! What both broad phases of `exact` share: the spheres of each grid cell
+//! as intrusive doubly linked lists (a sphere moves between cells in O(1)),
+//! and the split of the few large spheres off to a second level.
+use super::body::Body;
+
+pub const NONE: u32 = u32::MAX;
+
+#[derive(Clone, Debug, Default)]
+pub struct CellList {
+    head: Vec<u32>,
+    next: Vec<u32>,
+    prev: Vec<u32>,
+    /// The cell of each sphere, `NONE` for one in no cell.
+    cell: Vec<u32>,
+}
+
+impl CellList {
+    /// `spheres` spheres, none in a cell, and `cells` empty cells.
+    pub fn reset(&mut self, spheres: usize, cells: usize) {
+        for v in [&mut self.next, &mut self.prev, &mut self.cell] {
+            v.clear();
+            v.resize(spheres, NONE);
+        }
+        self.head.clear();
+        self.head.resize(cells, NONE);
+    }
+
+    #[inline]
+    pub fn cell(&self, i: usize) -> u32 {
+        self.cell[i]
+    }
+
+    pub fn insert(&mut self, i: usize, c: usize) {
+        self.cell[i] = c as u32;
+        self.prev[i] = NONE;
+        self.next[i] = self.head[c];
+        if self.head[c] != NONE {
+            self.prev[self.head[c] as usize] = i as u32;
+        }
+        self.head[c] = i as u32;
+    }
+
+    pub fn remove(&mut self, i: usize) {
+        let (p, n) = (self.prev[i], self.next[i]);
+        if p != NONE {
+            self.next[p as usize] = n;
+        } else {
+            self.head[self.cell[i] as usize] = n;
+        }
+        if n != NONE {
+            self.prev[n as usize] = p;
+        }
+    }
+
+    pub fn move_to(&mut self, i: usize, c: usize) {
+        self.remove(i);
+        self.insert(i, c);
+    }
+
+    /// Every sphere in cell `c`.
+    #[inline]
+    pub fn for_each_in(&self, c: usize, mut f: impl FnMut(u32)) {
+        let mut j = self.head[c];
+        while j != NONE {
+            f(j);
+            j = self.next[j as usize];
+        }
+    }
+}
+
+/// Spheres larger than `factor` times the bulk (98th percentile) radius go
+/// to the second level. Returns that threshold (infinite when the largest
+/// is within it) and the largest radius at or under it. `bodies` is not empty.
+pub fn split_big(bodies: &[Body], factor: f64) -> (f64, f64) {
+    let n = bodies.len();
+    let mut radii: Vec<f64> = bodies.iter().map(|b| b.radius).collect();
+    let k = (n * 98 / 100).min(n - 1);
+    let bulk = *radii.select_nth_unstable_by(k, f64::total_cmp).1;
+    let rmax = radii.iter().copied().fold(0.0, f64::max);
+    let big_above = if rmax <= factor * bulk {
+        f64::INFINITY
+    } else {
+        factor * bulk
+    };
+    let small_rmax = bodies
+        .iter()
+        .map(|b| b.radius)
+        .filter(|&r| r <= big_above)
+        .fold(0.0, f64::max);
+    (big_above, small_rmax)
+}
