@@ -4,21 +4,19 @@
 //! Wall contacts mirror the position back inside (no energy is added: only
 //! velocities carry energy). Overlaps are found on the moved positions,
 //! before the wall mirror.
-use super::broad::{Grid, Pair};
 use super::contact::resolve_pair;
-use super::exec::{Exec, for_each_block, for_each_chunk};
+use super::detect::{Detection, SPHERE_BLOCK};
+use super::exec::{Exec, for_each_chunk};
 use super::model::{Model, ModelKind};
 use super::sphere::Sphere;
-use super::swept::{SPHERE_BLOCK, pair_mut};
+use super::swept::pair_mut;
 use super::world::World;
-use parking_lot::Mutex;
 
 #[derive(Default)]
 pub struct Discrete {
-    grid: Grid,
-    pairs: Vec<Pair>,
-    /// Per block, the spheres found past a wall.
-    walls: Vec<Mutex<Vec<u32>>>,
+    detect: Detection,
+    /// The spheres found past a wall this step.
+    hits: Vec<u32>,
 }
 
 impl Model for Discrete {
@@ -37,11 +35,6 @@ impl Model for Discrete {
 impl Discrete {
     fn step(&mut self, world: &mut World, dt: f64, exec: &dyn Exec) {
         let size = world.size;
-        let n = world.spheres.len();
-        let blocks = n.div_ceil(SPHERE_BLOCK);
-        while self.walls.len() < blocks {
-            self.walls.push(Mutex::new(Vec::new()));
-        }
         for_each_chunk(exec, &mut world.spheres, SPHERE_BLOCK, &|_, chunk| {
             for s in chunk {
                 s.pos += s.vel * dt;
@@ -53,48 +46,21 @@ impl Discrete {
             let s = a.radius + b.radius;
             a.pos.distance_squared(b.pos) < s * s
         };
-        let walls = &self.walls;
-        let find_walls = |exec: &dyn Exec| {
-            for_each_block(exec, blocks, &|b| {
-                let mut v = walls[b].lock();
-                v.clear();
-                let end = ((b + 1) * SPHERE_BLOCK).min(n);
-                v.extend(
-                    (b * SPHERE_BLOCK..end)
-                        .filter(|&i| outside(&sp[i], size))
-                        .map(|i| i as u32),
-                );
-            })
-        };
-        if exec.functional() {
-            // Sphere–sphere work (which pairs overlap) beside sphere–wall
-            // work (which spheres are past a wall).
-            let serial = super::exec::Serial;
-            let detect = Mutex::new((&mut self.grid, &mut self.pairs));
-            exec.join(
-                &|| {
-                    let mut g = detect.lock();
-                    let (grid, pairs) = &mut *g;
-                    grid.build(sp, size, |s| (s.pos, s.radius), &serial);
-                    grid.pairs(&serial, &overlapping, pairs);
-                },
-                &|| find_walls(&serial),
-            );
-        } else {
-            self.grid.build(sp, size, |s| (s.pos, s.radius), exec);
-            self.grid.pairs(exec, &overlapping, &mut self.pairs);
-            find_walls(exec);
-        }
+        // Sphere–sphere work (which pairs overlap) beside sphere–wall work
+        // (which spheres are past a wall).
+        self.detect
+            .run(exec, sp, size, |s| (s.pos, s.radius), &overlapping, &|s| {
+                outside(s, size)
+            });
+        self.detect.wall_hits(&mut self.hits);
         // Answers in a fixed order: walls, then pairs, whatever thread found
         // them; a sphere in several pairs sees them one after another.
-        for w in &self.walls[..blocks] {
-            for &i in w.lock().iter() {
-                let (imp, hits) = bounce(&mut world.spheres[i as usize], size);
-                world.counters.wall_momentum += imp;
-                world.counters.wall_collisions += hits;
-            }
+        for &i in &self.hits {
+            let (imp, hits) = bounce(&mut world.spheres[i as usize], size);
+            world.counters.wall_momentum += imp;
+            world.counters.wall_collisions += hits;
         }
-        for &(i, j) in &self.pairs {
+        for &(i, j) in &self.detect.pairs {
             let (a, b) = pair_mut(&mut world.spheres, i as usize, j as usize);
             if resolve_pair(a, b) {
                 world.counters.sphere_collisions += 1;

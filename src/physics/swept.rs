@@ -6,21 +6,17 @@
 //! contacts inside a step are followed, not missed. The rest fly straight.
 //! A pathological step (near jamming) is cut off by an event cap, finished
 //! in free flight and counted in `capped_steps`.
-use super::broad::{Grid, Pair};
 use super::contact::{pair_toi, reflect_walls, resolve_pair, wall_toi};
-use super::exec::{Exec, for_each_block, for_each_chunk};
+use super::detect::{Detection, SPHERE_BLOCK};
+use super::exec::{Exec, for_each_chunk};
 use super::flight::fly;
 use super::model::{Model, ModelKind};
 use super::sphere::Sphere;
 use super::world::World;
 use glam::DVec3;
-use parking_lot::Mutex;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
-/// Spheres per parallel block; fixed so results never depend on the number
-/// of threads.
-pub(crate) const SPHERE_BLOCK: usize = 2048;
 const NONE: u32 = u32::MAX;
 /// Reach balls are widened by this much so touching spheres, whose distance
 /// rounds either way, are always seen.
@@ -28,9 +24,9 @@ const REACH_SLACK: f64 = 1.0 + 1e-9;
 
 #[derive(Default)]
 pub struct Swept {
-    grid: Grid,
-    pairs: Vec<Pair>,
-    wall_slots: Vec<Mutex<Vec<u32>>>,
+    detect: Detection,
+    /// The spheres whose path reaches a wall this step.
+    hits: Vec<u32>,
     /// Sphere index → local index among the spheres with events, or NONE.
     local: Vec<u32>,
     involved: Vec<u32>,
@@ -104,48 +100,17 @@ impl Model for Swept {
 impl Swept {
     fn step(&mut self, world: &mut World, dt: f64, exec: &dyn Exec) {
         let size = world.size;
-        let n = world.spheres.len();
-        self.grid
-            .build(&world.spheres, size, |s| path_ball(s, dt), exec);
-        let blocks = n.div_ceil(SPHERE_BLOCK);
-        while self.wall_slots.len() < blocks {
-            self.wall_slots.push(Mutex::new(Vec::new()));
-        }
         let sp = &world.spheres;
         let meets = |i: u32, j: u32| {
             let (a, b) = (&sp[i as usize], &sp[j as usize]);
             pair_toi(a.pos - b.pos, a.vel - b.vel, a.radius + b.radius).is_some_and(|t| t <= dt)
         };
-        let slots = &self.wall_slots;
-        let walls = |exec: &dyn Exec| {
-            for_each_block(exec, blocks, &|b| {
-                let mut v = slots[b].lock();
-                v.clear();
-                let end = ((b + 1) * SPHERE_BLOCK).min(n);
-                v.extend(
-                    (b * SPHERE_BLOCK..end)
-                        .filter(|&i| reaches_wall(&sp[i], size, dt))
-                        .map(|i| i as u32),
-                );
-            })
-        };
-        if exec.functional() {
-            // Functional decomposition: sphere–sphere beside sphere–wall.
-            let serial = super::exec::Serial;
-            let detect = Mutex::new((&mut self.grid, &mut self.pairs));
-            exec.join(
-                &|| {
-                    let mut g = detect.lock();
-                    let (grid, pairs) = &mut *g;
-                    grid.pairs(&serial, &meets, pairs);
-                },
-                &|| walls(&serial),
-            );
-        } else {
-            self.grid.pairs(exec, &meets, &mut self.pairs);
-            walls(exec);
-        }
-        self.events(world, dt, blocks);
+        self.detect
+            .run(exec, sp, size, |s| path_ball(s, dt), &meets, &|s| {
+                reaches_wall(s, size, dt)
+            });
+        self.detect.wall_hits(&mut self.hits);
+        self.events(world, dt);
         // Everyone without an event flies straight and meets no wall.
         let local = &self.local;
         for_each_chunk(exec, &mut world.spheres, SPHERE_BLOCK, &|b, chunk| {
@@ -171,14 +136,14 @@ impl Swept {
         let (centre, reach) = path_ball(s, dt);
         self.centre.push(centre);
         self.reach.push(reach);
-        self.cap.push(self.grid.growth_cap(reach));
+        self.cap.push(self.detect.grid.growth_cap(reach));
         push_wall(&mut self.heap, s, l, 0.0, 0, size, dt);
         l
     }
 
     /// Contacts in time order within `[0, dt]`; leaves every sphere with an
     /// event at `dt`, and `local` marking them.
-    fn events(&mut self, world: &mut World, dt: f64, blocks: usize) {
+    fn events(&mut self, world: &mut World, dt: f64) {
         for &i in &self.involved {
             self.local[i as usize] = NONE;
         }
@@ -193,7 +158,7 @@ impl Swept {
         self.grown.clear();
         self.heap.clear();
         let size = world.size;
-        let pairs = std::mem::take(&mut self.pairs);
+        let pairs = std::mem::take(&mut self.detect.pairs);
         let sp = &mut world.spheres;
         for &(i, j) in &pairs {
             let a = self.involve(sp, i, dt, size);
@@ -203,14 +168,12 @@ impl Swept {
                 self.heap.push(pair_event(t, a, b, 0, 0));
             }
         }
-        self.pairs = pairs;
-        for b in 0..blocks {
-            let hitters = std::mem::take(&mut *self.wall_slots[b].lock());
-            for &i in &hitters {
-                self.involve(sp, i, dt, size);
-            }
-            *self.wall_slots[b].lock() = hitters;
+        self.detect.pairs = pairs;
+        let hits = std::mem::take(&mut self.hits);
+        for &i in &hits {
+            self.involve(sp, i, dt, size);
         }
+        self.hits = hits;
         let cap = 10_000 + 64 * self.involved.len();
         let mut done = 0usize;
         while let Some(e) = self.heap.pop() {
@@ -285,7 +248,7 @@ impl Swept {
                 found.push(j);
             }
         };
-        self.grid.near(p0, ra, &mut consider);
+        self.detect.grid.near(p0, ra, &mut consider);
         for &g in &self.grown {
             let lg = g as usize;
             consider(self.involved[lg], self.centre[lg], self.reach[lg]);

@@ -1,0 +1,84 @@
+//! The detection half of a step, shared by the per-step models: which pairs
+//! the grid finds (sphere–sphere work) and which spheres a predicate picks
+//! for wall handling (sphere–wall work). On a functional executor (`split`)
+//! the two run side by side; otherwise each is cut into blocks over the
+//! lanes (`pool`). Either way the results are the same bits.
+use super::broad::{Grid, Pair};
+use super::exec::{Exec, Serial, for_each_block};
+use super::sphere::Sphere;
+use glam::DVec3;
+use parking_lot::Mutex;
+
+/// Spheres per parallel block; fixed so results never depend on the number
+/// of threads.
+pub(crate) const SPHERE_BLOCK: usize = 2048;
+
+/// Where detection leaves its answers, kept between steps to reuse memory.
+#[derive(Default)]
+pub(crate) struct Detection {
+    pub grid: Grid,
+    /// Pairs the grid found and `keep` accepted, in a fixed order.
+    pub pairs: Vec<Pair>,
+    /// Per block of spheres, in order, the ones `wall` picked.
+    pub walls: Vec<Mutex<Vec<u32>>>,
+}
+
+impl Detection {
+    pub fn run<B, K, W>(
+        &mut self,
+        exec: &dyn Exec,
+        spheres: &[Sphere],
+        size: f64,
+        ball: B,
+        keep: &K,
+        wall: &W,
+    ) where
+        B: Fn(&Sphere) -> (DVec3, f64) + Sync,
+        K: Fn(u32, u32) -> bool + Sync,
+        W: Fn(&Sphere) -> bool + Sync,
+    {
+        let n = spheres.len();
+        let blocks = n.div_ceil(SPHERE_BLOCK);
+        while self.walls.len() < blocks {
+            self.walls.push(Mutex::new(Vec::new()));
+        }
+        self.walls.truncate(blocks);
+        let slots = &self.walls;
+        let find_walls = |exec: &dyn Exec| {
+            for_each_block(exec, blocks, &|b| {
+                let mut v = slots[b].lock();
+                v.clear();
+                let end = ((b + 1) * SPHERE_BLOCK).min(n);
+                v.extend(
+                    (b * SPHERE_BLOCK..end)
+                        .filter(|&i| wall(&spheres[i]))
+                        .map(|i| i as u32),
+                );
+            })
+        };
+        if exec.functional() {
+            let pair_job = Mutex::new((&mut self.grid, &mut self.pairs));
+            exec.join(
+                &|| {
+                    let mut job = pair_job.lock();
+                    let (grid, pairs) = &mut *job;
+                    grid.build(spheres, size, &ball, &Serial);
+                    grid.pairs(&Serial, keep, pairs);
+                },
+                &|| find_walls(&Serial),
+            );
+        } else {
+            self.grid.build(spheres, size, &ball, exec);
+            self.grid.pairs(exec, keep, &mut self.pairs);
+            find_walls(exec);
+        }
+    }
+
+    /// The spheres `wall` picked, in sphere order, into `out`.
+    pub fn wall_hits(&self, out: &mut Vec<u32>) {
+        out.clear();
+        for w in &self.walls {
+            out.extend_from_slice(&w.lock());
+        }
+    }
+}
