@@ -80,59 +80,43 @@ fn render(w: u16, h: u16, f: impl FnOnce(&mut ratatui::Frame)) -> Terminal<TestB
     t
 }
 
-#[test]
-fn readouts_panel() {
-    let (st, snap, stats) = (state(), snapshot(), stats());
-    let t = render(44, 18, |f| {
+fn readouts(st: &AppState, snap: &Snapshot, palette: Palette) -> Terminal<TestBackend> {
+    let stats = stats();
+    render(44, 18, |f| {
         f.render_widget(
             Readouts {
-                state: &st,
-                snap: &snap,
+                state: st,
+                snap,
                 stats: &stats,
-                palette: Palette::C16,
+                palette,
             },
             f.area(),
         )
-    });
+    })
+}
+
+#[test]
+fn readouts_panel() {
+    let t = readouts(&state(), &snapshot(), Palette::C16);
     insta::assert_snapshot!(t.backend());
 }
 
 #[test]
 fn readouts_panel_says_when_the_event_cap_was_hit() {
-    let (st, mut snap, stats) = (state(), snapshot(), stats());
+    let mut snap = snapshot();
     snap.counters.capped_steps = 3;
-    let t = render(44, 18, |f| {
-        f.render_widget(
-            Readouts {
-                state: &st,
-                snap: &snap,
-                stats: &stats,
-                palette: Palette::C16,
-            },
-            f.area(),
-        )
-    });
+    let t = readouts(&state(), &snap, Palette::C16);
     let text = format!("{:?}", t.backend().buffer());
     assert!(text.contains("event cap hit in 3 steps"), "{text}");
 }
 
 #[test]
 fn readouts_panel_paused_in_pool_mode() {
-    let (mut st, snap, stats) = (state(), snapshot(), stats());
+    let mut st = state();
     st.threading = Threading::Pool;
     st.threads = 3;
     st.paused = true;
-    let t = render(44, 18, |f| {
-        f.render_widget(
-            Readouts {
-                state: &st,
-                snap: &snap,
-                stats: &stats,
-                palette: Palette::Mono,
-            },
-            f.area(),
-        )
-    });
+    let t = readouts(&st, &snapshot(), Palette::Mono);
     insta::assert_snapshot!(t.backend());
     // Without colour, the pause cue is reverse video.
     let buf = t.backend().buffer();
