@@ -111,6 +111,16 @@ fn readouts_panel_says_when_the_event_cap_was_hit() {
 }
 
 #[test]
+fn readouts_panel_says_exact_runs_on_one_thread_in_pool_mode() {
+    let mut st = state();
+    st.threading = Threading::Pool;
+    st.model = ballpit::physics::ModelKind::Exact;
+    let t = readouts(&st, &snapshot(), Palette::C16);
+    let text = format!("{:?}", t.backend().buffer());
+    assert!(text.contains("pool     exact runs on physics"), "{text}");
+}
+
+#[test]
 fn readouts_panel_paused_in_pool_mode() {
     let mut st = state();
     st.threading = Threading::Pool;

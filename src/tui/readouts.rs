@@ -3,6 +3,7 @@
 use super::state::{AppState, physics_threads};
 use super::theme::Palette;
 use crate::engine::{Snapshot, Threading};
+use crate::physics::ModelKind;
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
 use ratatui::text::{Line, Span};
@@ -50,6 +51,10 @@ impl Readouts<'_> {
         let threads = physics_threads(s.threading, s.threads);
         let threading = match s.threading {
             Threading::Off => format!("off      on main; t -> {}", s.last_threaded),
+            // The event loop of `exact` does not split: say where it runs.
+            t @ (Threading::Pool | Threading::Split) if s.model == ModelKind::Exact => {
+                format!("{:<8} exact runs on physics", t.name())
+            }
             t => format!(
                 "{:<8} {threads} physics thread{}",
                 t.name(),
