@@ -145,6 +145,84 @@ impl Level {
         }
     }
 
+    /// The same counting sort as [`Level::fill`] for the first level, cut
+    /// by key range over the executor's lanes: each lane counts, sums and
+    /// places only the keys of its range, into its own part of the cell
+    /// table and of the entries, so the layout is the same for any number
+    /// of lanes. `keys[i]` is sphere `i`'s cell, `u32::MAX` for none.
+    fn fill_lanes(&mut self, keys: &[u32], balls: &[(DVec3, f64)], exec: &dyn Exec) {
+        let cells = self.cell_start.len() - 1;
+        let lanes = exec.lanes().clamp(1, 64).min(cells);
+        let bounds: Vec<usize> = (0..=lanes).map(|l| l * cells / lanes).collect();
+        let mut tables: Vec<Mutex<&mut [u32]>> = Vec::with_capacity(lanes);
+        let mut rest = &mut self.cell_start[..cells];
+        for l in 0..lanes {
+            let (mine, more) = rest.split_at_mut(bounds[l + 1] - bounds[l]);
+            tables.push(Mutex::new(mine));
+            rest = more;
+        }
+        let totals: Vec<Mutex<(u32, f64)>> = (0..lanes).map(|_| Mutex::new((0, 0.0))).collect();
+        exec.for_each_lane(&|l| {
+            if l >= lanes {
+                return;
+            }
+            let (lo, hi) = (bounds[l] as u32, bounds[l + 1] as u32);
+            let mut table = tables[l].lock();
+            let mut reach_max: f64 = 0.0;
+            for (&k, b) in keys.iter().zip(balls) {
+                if k >= lo && k < hi {
+                    table[(k - lo) as usize] += 1;
+                    reach_max = reach_max.max(b.1);
+                }
+            }
+            *totals[l].lock() = (table.iter().sum(), reach_max);
+        });
+        let mut offsets = Vec::with_capacity(lanes + 1);
+        let mut sum = 0u32;
+        for t in &totals {
+            let (count, reach_max) = *t.lock();
+            offsets.push(sum);
+            sum += count;
+            self.reach_max = self.reach_max.max(reach_max);
+        }
+        offsets.push(sum);
+        self.entries.resize(sum as usize, Entry::default());
+        let mut regions: Vec<Mutex<&mut [Entry]>> = Vec::with_capacity(lanes);
+        let mut rest = &mut self.entries[..];
+        for l in 0..lanes {
+            let (mine, more) = rest.split_at_mut((offsets[l + 1] - offsets[l]) as usize);
+            regions.push(Mutex::new(mine));
+            rest = more;
+        }
+        exec.for_each_lane(&|l| {
+            if l >= lanes {
+                return;
+            }
+            let (lo, hi) = (bounds[l] as u32, bounds[l + 1] as u32);
+            let mut table = tables[l].lock();
+            let mut end = offsets[l];
+            for c in table.iter_mut() {
+                end += *c;
+                *c = end;
+            }
+            let mut out = regions[l].lock();
+            for (i, (&key, &(pos, reach))) in keys.iter().zip(balls).enumerate().rev() {
+                if key >= lo && key < hi {
+                    let slot = &mut table[(key - lo) as usize];
+                    *slot -= 1;
+                    out[(*slot - offsets[l]) as usize] = Entry {
+                        pos,
+                        reach,
+                        id: i as u32,
+                        key,
+                    };
+                }
+            }
+        });
+        drop(tables);
+        self.cell_start[cells] = sum;
+    }
+
     fn key_blocks(&self) -> usize {
         (self.cell_start.len() - 1).div_ceil(KEY_BLOCK)
     }
@@ -277,18 +355,7 @@ impl Grid {
                 });
             }
             let (keys, balls) = (&self.keys, &self.balls);
-            let placed = keys
-                .iter()
-                .zip(balls)
-                .enumerate()
-                .filter(|(_, (k, _))| **k != u32::MAX)
-                .map(|(i, (&key, &(pos, reach)))| Entry {
-                    pos,
-                    reach,
-                    id: i as u32,
-                    key,
-                });
-            level.fill(placed);
+            level.fill_lanes(keys, balls, exec);
             self.rest.clear();
             self.rest.extend(
                 keys.iter()
