@@ -2,6 +2,7 @@
 //! as intrusive doubly linked lists (a sphere moves between cells in O(1)),
 //! and the split of the few large spheres off to a second level.
 use super::body::Body;
+use glam::DVec3;
 
 pub const NONE: u32 = u32::MAX;
 
@@ -88,4 +89,27 @@ pub fn split_big(bodies: &[Body], factor: f64) -> (f64, f64) {
         .filter(|&r| r <= big_above)
         .fold(0.0, f64::max);
     (big_above, small_rmax)
+}
+
+/// Time until a point at offset `d` from a ball's centre, moving at `v`,
+/// reaches the ball's edge (radius `r`): 0 if already outside, infinite if
+/// at rest. The root of `a t^2 + 2 b t + c = 0` (c < 0) in the form that
+/// never subtracts nearly equal numbers.
+#[inline]
+pub fn time_to_leave(d: DVec3, v: DVec3, r: f64) -> f64 {
+    let a = v.length_squared();
+    if a == 0.0 {
+        return f64::INFINITY;
+    }
+    let c = d.length_squared() - r * r;
+    if c >= 0.0 {
+        return 0.0;
+    }
+    let b = d.dot(v);
+    let disc = (b * b - a * c).sqrt();
+    if b > 0.0 {
+        -c / (b + disc)
+    } else {
+        (disc - b) / a
+    }
 }

@@ -12,7 +12,7 @@
 //! the skin (a small sphere entering that reach does so by a crossing, which
 //! checks the large ones).
 use super::body::Body;
-use super::cell_list::{CellList, NONE, split_big};
+use super::cell_list::{CellList, NONE, split_big, time_to_leave};
 use super::schedule::{Event, Kind};
 use glam::DVec3;
 
@@ -77,23 +77,10 @@ impl Cells {
     pub fn next_event(&self, i: usize, b: &Body) -> (f64, Event) {
         if self.is_big(i) {
             let d = b.pos - self.scan_centre[self.big_slot[i] as usize];
-            let a = b.vel.length_squared();
-            if a == 0.0 {
+            let t = time_to_leave(d, b.vel, self.skin * (1.0 - 1e-6));
+            if t == f64::INFINITY {
                 return (f64::INFINITY, Event::default());
             }
-            let r = self.skin * (1.0 - 1e-6);
-            let c = d.length_squared() - r * r;
-            let t = if c >= 0.0 {
-                0.0
-            } else {
-                let bb = d.dot(b.vel);
-                let disc = (bb * bb - a * c).sqrt();
-                if bb > 0.0 {
-                    -c / (bb + disc)
-                } else {
-                    (disc - bb) / a
-                }
-            };
             let ev = Event {
                 kind: Kind::Relist,
                 ..Event::default()

@@ -17,7 +17,7 @@
 use super::body::Body;
 use glam::DVec3;
 
-use super::cell_list::{CellList, NONE, split_big};
+use super::cell_list::{CellList, NONE, split_big, time_to_leave};
 /// A sphere counts as large (second level) above this multiple of the bulk radius.
 const BIG_FACTOR: f64 = 3.0;
 /// Skin as a fraction of the bulk radius, at least: a quarter diameter
@@ -249,25 +249,7 @@ impl Neighbours {
     /// Time from `b.t` until sphere `i` has wandered to the edge of its skin.
     #[inline]
     pub fn relist_time(&self, i: usize, b: &Body) -> f64 {
-        let d = b.pos - self.centre[i].pos;
-        let a = b.vel.length_squared();
-        if a == 0.0 {
-            return f64::INFINITY;
-        }
-        let r = self.skin * TRIGGER;
-        let c = d.length_squared() - r * r;
-        if c >= 0.0 {
-            return 0.0;
-        }
-        // Root of a t^2 + 2 bb t + c = 0 with c < 0, in the form that never
-        // subtracts nearly equal numbers.
-        let bb = d.dot(b.vel);
-        let disc = (bb * bb - a * c).sqrt();
-        if bb > 0.0 {
-            -c / (bb + disc)
-        } else {
-            (disc - bb) / a
-        }
+        time_to_leave(b.pos - self.centre[i].pos, b.vel, self.skin * TRIGGER)
     }
 
     /// Find the neighbours `j` of `i` (with `want(j)`) and link both ways.
