@@ -94,46 +94,18 @@ fn frames(world: World, frames: usize) -> Vec<Snapshot> {
         .collect()
 }
 
-fn bench_frame(c: &mut Criterion) {
-    let snaps = frames(lattice_world(10_000, 0.01, 0.5, 7), 2);
-    for (name, style) in [
-        ("braille", DrawStyle::PointsSpeed),
-        ("shaded", DrawStyle::Shaded),
-    ] {
-        let mut st = AppState::new(&settings(), 10_000, 0.01, 30.0);
-        st.style = style;
-        let stats = Stats::default();
-        let report = CpuReport::default();
-        let (mut t, _) = terminal(200, 60);
-        let mut raster = Raster::new();
-        let mut k = 0;
-        c.bench_function(&format!("frame/10k_spheres_200x60_{name}"), |b| {
-            b.iter(|| {
-                k += 1;
-                let view = View {
-                    state: &st,
-                    snap: &snaps[k % 2],
-                    stats: &stats,
-                    report: &report,
-                    palette: Palette::C16,
-                    aspect: 2.0,
-                };
-                frame(&mut t, &mut raster, &view);
-            })
-        });
-    }
-    // 100 000 spheres still draw (as points).
-    let snaps = frames(lattice_world(100_000, 0.002, 0.5, 7), 2);
-    let st = AppState::new(&settings(), 100_000, 0.002, 30.0);
+/// Time building whole frames at 200×60, alternating two snapshots so every
+/// frame has changes to send.
+fn bench_view(c: &mut Criterion, id: &str, st: &AppState, snaps: &[Snapshot]) {
     let (stats, report) = (Stats::default(), CpuReport::default());
     let (mut t, _) = terminal(200, 60);
     let mut raster = Raster::new();
     let mut k = 0;
-    c.bench_function("frame/100k_spheres_200x60_braille", |b| {
+    c.bench_function(id, |b| {
         b.iter(|| {
             k += 1;
             let view = View {
-                state: &st,
+                state: st,
                 snap: &snaps[k % 2],
                 stats: &stats,
                 report: &report,
@@ -143,6 +115,22 @@ fn bench_frame(c: &mut Criterion) {
             frame(&mut t, &mut raster, &view);
         })
     });
+}
+
+fn bench_frame(c: &mut Criterion) {
+    let snaps = frames(lattice_world(10_000, 0.01, 0.5, 7), 2);
+    for (name, style) in [
+        ("braille", DrawStyle::PointsSpeed),
+        ("shaded", DrawStyle::Shaded),
+    ] {
+        let mut st = AppState::new(&settings(), 10_000, 0.01, 30.0);
+        st.style = style;
+        bench_view(c, &format!("frame/10k_spheres_200x60_{name}"), &st, &snaps);
+    }
+    // 100 000 spheres still draw (as points).
+    let snaps = frames(lattice_world(100_000, 0.002, 0.5, 7), 2);
+    let st = AppState::new(&settings(), 100_000, 0.002, 30.0);
+    bench_view(c, "frame/100k_spheres_200x60_braille", &st, &snaps);
 }
 
 /// Bytes written per second at 120×40, default scene, 30 fps, 3 seconds.
