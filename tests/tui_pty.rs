@@ -74,6 +74,25 @@ impl App {
         w.flush().unwrap();
     }
 
+    /// Resize the terminal and the screen model that parses it.
+    fn resize(&self, rows: u16, cols: u16) {
+        self.master
+            .as_ref()
+            .unwrap()
+            .resize(PtySize {
+                rows,
+                cols,
+                pixel_width: 0,
+                pixel_height: 0,
+            })
+            .unwrap();
+        self.screen
+            .lock()
+            .unwrap()
+            .screen_mut()
+            .set_size(nz(rows), nz(cols));
+    }
+
     /// Wait until `pred` holds for the screen text; the text when it does.
     fn wait_for(&self, what: &str, secs: f64, pred: impl Fn(&str) -> bool) -> String {
         let end = Instant::now() + Duration::from_secs_f64(secs);
@@ -247,36 +266,10 @@ fn sigterm_restores_the_terminal_and_exits_non_zero() {
 fn a_small_terminal_gets_told_how_big_it_must_be_and_resizing_recovers() {
     let mut app = start(&[], None);
     app.wait_for("the readouts", 10.0, |s| s.contains("threading"));
-    let master = app.master.as_ref().unwrap();
-    master
-        .resize(PtySize {
-            rows: 15,
-            cols: 50,
-            pixel_width: 0,
-            pixel_height: 0,
-        })
-        .unwrap();
-    app.screen
-        .lock()
-        .unwrap()
-        .screen_mut()
-        .set_size(nz(15), nz(50));
+    app.resize(15, 50);
     let s = app.wait_for("the size message", 3.0, |s| s.contains("at least"));
     assert!(s.contains("72x22") && s.contains("50x15"), "{s}");
-    let master = app.master.as_ref().unwrap();
-    master
-        .resize(PtySize {
-            rows: 40,
-            cols: 120,
-            pixel_width: 0,
-            pixel_height: 0,
-        })
-        .unwrap();
-    app.screen
-        .lock()
-        .unwrap()
-        .screen_mut()
-        .set_size(nz(40), nz(120));
+    app.resize(40, 120);
     app.wait_for("the readouts again", 3.0, |s| {
         s.contains("threading") && !s.contains("at least")
     });
