@@ -25,12 +25,18 @@ fn main() {
         ..Default::default()
     })
     .expect("scene");
+    let threads: usize = arg(5, "1").parse().expect("threads");
+    let pool = (threads > 1).then(|| ballpit::engine::PoolExec::new(threads).expect("pool"));
+    let exec: &dyn ballpit::physics::Exec = match &pool {
+        Some(p) => p,
+        None => &Serial,
+    };
     let mut m = model.build();
     let start = Instant::now();
-    m.advance(&mut world, 1.0 / 60.0, steps, &Serial);
+    m.advance(&mut world, 1.0 / 60.0, steps, exec);
     let secs = start.elapsed().as_secs_f64();
     println!(
-        "{model} n={n} packing={phi} steps={steps}: {:.2} M sphere-steps/s, {} contacts, {} wall hits",
+        "{model} n={n} packing={phi} steps={steps} threads={threads}: {:.2} M sphere-steps/s, {} contacts, {} wall hits",
         (n as u64 * steps) as f64 / secs / 1e6,
         world.counters.sphere_collisions,
         world.counters.wall_collisions

@@ -1,0 +1,431 @@
+//! One cluster's contact events within a step, on private copies of its
+//! spheres: the serial event loop of `swept` (time order, lazy clocks,
+//! collision counters, rescans on every velocity change), run for a set of
+//! spheres that should not touch anyone outside it. When a rescan finds that
+//! they might after all, the run stops and names the outsider, so the
+//! caller can merge and run again (see `rounds`).
+use super::{NONE, REACH_SLACK, path_ball};
+use crate::physics::broad::Grid;
+use crate::physics::contact::{pair_toi, reflect_walls, resolve_pair, wall_toi};
+use crate::physics::flight::fly;
+use crate::physics::sphere::Sphere;
+use crate::physics::swept::pair_mut;
+use glam::DVec3;
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+/// What every run of a step reads: the state at the start of the step and
+/// this round's partition.
+pub(super) struct Shared<'a> {
+    pub spheres: &'a [Sphere],
+    pub grid: &'a Grid,
+    /// Sphere id → its slot among the involved spheres, or NONE.
+    pub slot: &'a [u32],
+    /// Slot → cluster of this round.
+    pub cluster_of: &'a [u32],
+    pub size: f64,
+    pub dt: f64,
+}
+
+/// An event; `a`, `b` are sphere ids (`b` NONE for a wall), `la`, `lb` the
+/// run's local indices, `ca`, `cb` the collision counts it was predicted at.
+#[derive(Clone, Copy, Debug)]
+struct Event {
+    t: f64,
+    a: u32,
+    b: u32,
+    la: u32,
+    lb: u32,
+    ca: u32,
+    cb: u32,
+}
+
+impl PartialEq for Event {
+    fn eq(&self, o: &Self) -> bool {
+        self.cmp(o) == Ordering::Equal
+    }
+}
+impl Eq for Event {}
+impl PartialOrd for Event {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Event {
+    /// Reversed so the heap pops the earliest. Simultaneous events in a
+    /// fixed order that does not depend on how spheres were grouped: lower
+    /// sphere id first, pair events before wall events.
+    fn cmp(&self, o: &Self) -> Ordering {
+        o.t.total_cmp(&self.t)
+            .then(o.a.cmp(&self.a))
+            .then(o.b.cmp(&self.b))
+    }
+}
+
+/// One member's result of a finished run.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Member {
+    pub id: u32,
+    pub sphere: Sphere,
+    /// Momentum given to the walls, for the pressure.
+    pub wall_momentum: f64,
+    pub wall_hits: u32,
+    /// Sphere–sphere collisions this member was the lower id of.
+    pub pair_hits: u32,
+    /// The ball its whole path of the step stays in, and whether that grew
+    /// past the ball the grid holds for it.
+    pub centre: DVec3,
+    pub reach: f64,
+    pub grew: bool,
+}
+
+/// Scratch for one run, kept to reuse memory.
+#[derive(Default)]
+pub(super) struct Run {
+    ids: Vec<u32>,
+    /// Slot → local index for members with a slot, NONE otherwise; kept
+    /// all NONE between runs.
+    local_of_slot: Vec<u32>,
+    /// Outsiders taken in (sphere ids), and sphere id → local index for
+    /// them (NONE otherwise; sized to the spheres once a run absorbs).
+    taken: Vec<u32>,
+    taken_local: Vec<u32>,
+    sp: Vec<Sphere>,
+    t_local: Vec<f64>,
+    count: Vec<u32>,
+    centre: Vec<DVec3>,
+    reach: Vec<f64>,
+    reach0: Vec<f64>,
+    /// How far each reach may grow before the grid can no longer find it.
+    cap: Vec<f64>,
+    grown: Vec<u32>,
+    wall_momentum: Vec<f64>,
+    wall_hits: Vec<u32>,
+    pair_hits: Vec<u32>,
+    heap: BinaryHeap<Event>,
+    found: Vec<u32>,
+    /// Set when the run hit its event cap.
+    pub capped: bool,
+    /// Outsiders a member may touch: when not empty, the run's results are
+    /// void and it names whom to merge with. A doomed run goes on to the
+    /// end so that one round finds all it must merge with.
+    pub conflicts: Vec<u32>,
+}
+
+impl Run {
+    /// Runs the events of cluster `c` (its `members` and the
+    /// `pairs` detection found among them); true when it is valid (no
+    /// conflicts). With `absorb`, a sphere outside every cluster that a
+    /// member meets joins this run instead of conflicting (safe only when
+    /// no other run is going on).
+    pub fn run(
+        &mut self,
+        sh: &Shared,
+        c: u32,
+        members: &[u32],
+        pairs: &[(u32, u32)],
+        absorb: bool,
+    ) -> bool {
+        self.clear(sh.cluster_of.len());
+        for &i in members {
+            let l = self.involve(sh, i);
+            self.local_of_slot[sh.slot[i as usize] as usize] = l;
+        }
+        self.events(sh, c, pairs, absorb);
+        for &i in &self.ids {
+            let s = sh.slot[i as usize];
+            if s != NONE {
+                self.local_of_slot[s as usize] = NONE;
+            }
+        }
+        for &i in &self.taken {
+            self.taken_local[i as usize] = NONE;
+        }
+        self.conflicts.sort_unstable();
+        self.conflicts.dedup();
+        self.conflicts.is_empty()
+    }
+
+    fn events(&mut self, sh: &Shared, c: u32, pairs: &[(u32, u32)], absorb: bool) {
+        for &(i, j) in pairs {
+            let a = self.local_of_slot[sh.slot[i as usize] as usize];
+            let b = self.local_of_slot[sh.slot[j as usize] as usize];
+            let (si, sj) = (&self.sp[a as usize], &self.sp[b as usize]);
+            if let Some(t) = pair_toi(si.pos - sj.pos, si.vel - sj.vel, si.radius + sj.radius) {
+                self.heap.push(pair_event(t, i, j, a, b, 0, 0));
+            }
+        }
+        let cap = 10_000 + 64 * self.ids.len();
+        let mut done = 0usize;
+        while let Some(e) = self.heap.pop() {
+            let (la, lb) = (e.la as usize, e.lb as usize);
+            if self.count[la] != e.ca || (e.b != NONE && self.count[lb] != e.cb) {
+                continue;
+            }
+            done += 1;
+            if done > cap {
+                self.capped = true;
+                break;
+            }
+            self.advance_to(la, e.t);
+            self.count[la] += 1;
+            if e.b == NONE {
+                let (_, mask) = wall_toi(&self.sp[la], sh.size);
+                let (imp, hits) = reflect_walls(&mut self.sp[la], mask);
+                self.wall_momentum[la] += imp;
+                self.wall_hits[la] += hits as u32;
+                self.rescan(sh, c, la, e.t, absorb);
+            } else {
+                self.advance_to(lb, e.t);
+                self.count[lb] += 1;
+                let (x, y) = pair_mut(&mut self.sp, la, lb);
+                if resolve_pair(x, y) {
+                    self.pair_hits[la.min(lb)] += 1;
+                }
+                self.rescan(sh, c, la, e.t, absorb);
+                self.rescan(sh, c, lb, e.t, absorb);
+            }
+        }
+        for l in 0..self.ids.len() {
+            if self.count[l] == 0 {
+                // No event after all: the straight flight everyone without
+                // one makes, to the bit, whoever counted it in.
+                let s = &mut self.sp[l];
+                s.pos += s.vel * sh.dt;
+                continue;
+            }
+            let (imp, hits) = fly(&mut self.sp[l], sh.size, sh.dt - self.t_local[l]);
+            self.wall_momentum[l] += imp;
+            self.wall_hits[l] += hits as u32;
+        }
+    }
+
+    /// The members of the last finished run.
+    pub fn members(&self) -> impl Iterator<Item = Member> + '_ {
+        (0..self.ids.len()).map(|l| Member {
+            id: self.ids[l],
+            sphere: self.sp[l],
+            wall_momentum: self.wall_momentum[l],
+            wall_hits: self.wall_hits[l],
+            pair_hits: self.pair_hits[l],
+            centre: self.centre[l],
+            reach: self.reach[l],
+            grew: self.reach[l] > self.reach0[l],
+        })
+    }
+
+    fn clear(&mut self, slots: usize) {
+        if self.local_of_slot.len() < slots {
+            self.local_of_slot.resize(slots, NONE);
+        }
+        self.ids.clear();
+        self.taken.clear();
+        self.sp.clear();
+        self.t_local.clear();
+        self.count.clear();
+        self.centre.clear();
+        self.reach.clear();
+        self.reach0.clear();
+        self.cap.clear();
+        self.grown.clear();
+        self.wall_momentum.clear();
+        self.wall_hits.clear();
+        self.pair_hits.clear();
+        self.heap.clear();
+        self.capped = false;
+        self.conflicts.clear();
+    }
+
+    /// Local index of sphere `j` if it is a member of this run (cluster
+    /// `c`).
+    #[inline(always)]
+    fn member(&self, sh: &Shared, c: u32, j: u32) -> Option<usize> {
+        let s = sh.slot[j as usize];
+        if s != NONE {
+            if sh.cluster_of[s as usize] == c {
+                return Some(self.local_of_slot[s as usize] as usize);
+            }
+            return None;
+        }
+        if self.taken.is_empty() {
+            return None;
+        }
+        match self.taken_local[j as usize] {
+            NONE => None,
+            l => Some(l as usize),
+        }
+    }
+
+    /// Adds sphere `i` (at the start of the step) to the run; returns its
+    /// local index.
+    fn involve(&mut self, sh: &Shared, i: u32) -> u32 {
+        let l = self.ids.len() as u32;
+        let s = sh.spheres[i as usize];
+        self.ids.push(i);
+        self.sp.push(s);
+        self.t_local.push(0.0);
+        self.count.push(0);
+        let (centre, reach) = path_ball(&s, sh.dt);
+        self.centre.push(centre);
+        self.reach.push(reach);
+        self.reach0.push(reach);
+        self.cap.push(sh.grid.growth_cap(reach));
+        self.wall_momentum.push(0.0);
+        self.wall_hits.push(0);
+        self.pair_hits.push(0);
+        push_wall(&mut self.heap, &s, i, l, 0.0, 0, sh.size, sh.dt);
+        l
+    }
+
+    #[inline]
+    fn advance_to(&mut self, l: usize, t: f64) {
+        let s = &mut self.sp[l];
+        s.pos += s.vel * (t - self.t_local[l]);
+        self.t_local[l] = t;
+    }
+
+    /// Member `la` changed velocity at `t`: widen its ball if its new path
+    /// needs it, and schedule its next wall and every member it can now meet
+    /// before the step ends. Anyone else it might meet is a conflict.
+    fn rescan(&mut self, sh: &Shared, c: u32, la: usize, t: f64, absorb: bool) {
+        let sa = self.sp[la];
+        let ia = self.ids[la];
+        let need =
+            ((sa.pos - self.centre[la]).length() + sa.vel.length() * (sh.dt - t) + sa.radius)
+                * REACH_SLACK;
+        // A sphere may grow up to its cap and still be found through the
+        // grid; beyond that it joins `grown`, which every rescan checks.
+        if need > self.reach[la] {
+            if need > self.cap[la] && self.reach[la] <= self.cap[la] {
+                self.grown.push(la as u32);
+            }
+            self.reach[la] = need;
+        }
+        let ca = self.count[la];
+        push_wall(&mut self.heap, &sa, ia, la as u32, t, ca, sh.size, sh.dt);
+        let (p0, ra) = (self.centre[la], self.reach[la]);
+        let mut found = std::mem::take(&mut self.found);
+        found.clear();
+        {
+            let this = &*self;
+            // Outsiders are judged by the ball the grid holds for them: a
+            // run never reads another run's state.
+            let mut consider = |j: u32, pj0: DVec3, rj: f64| {
+                let rj = this.member(sh, c, j).map_or(rj, |l| this.reach[l]);
+                if p0.distance_squared(pj0) <= (ra + rj) * (ra + rj) {
+                    found.push(j);
+                }
+            };
+            sh.grid.near(p0, ra, &mut consider);
+            for &g in &this.grown {
+                let lg = g as usize;
+                consider(this.ids[lg], this.centre[lg], this.reach[lg]);
+            }
+        }
+        found.sort_unstable();
+        found.dedup();
+        for &j in &found {
+            if j == ia {
+                continue;
+            }
+            let l = self.member(sh, c, j);
+            if l.is_none() && sh.slot[j as usize] != NONE {
+                // A member of another cluster whose ball meets ours: its path
+                // is not known here.
+                self.conflicts.push(j);
+                continue;
+            }
+            let s = match l {
+                Some(l) => {
+                    let s = &self.sp[l];
+                    Sphere {
+                        pos: s.pos + s.vel * (t - self.t_local[l]),
+                        ..*s
+                    }
+                }
+                None => {
+                    let s = &sh.spheres[j as usize];
+                    Sphere {
+                        pos: s.pos + s.vel * t,
+                        ..*s
+                    }
+                }
+            };
+            let Some(dtc) = pair_toi(sa.pos - s.pos, sa.vel - s.vel, sa.radius + s.radius) else {
+                continue;
+            };
+            if t + dtc > sh.dt {
+                continue;
+            }
+            let lb = match l {
+                Some(l) => l as u32,
+                None if absorb => {
+                    let l = self.involve(sh, j);
+                    if self.taken_local.len() < sh.spheres.len() {
+                        self.taken_local.resize(sh.spheres.len(), NONE);
+                    }
+                    self.taken.push(j);
+                    self.taken_local[j as usize] = l;
+                    l
+                }
+                None => {
+                    self.conflicts.push(j);
+                    continue;
+                }
+            };
+            let cb = self.count[lb as usize];
+            self.heap
+                .push(pair_event(t + dtc, ia, j, la as u32, lb, ca, cb));
+        }
+        self.found = found;
+    }
+}
+
+fn pair_event(t: f64, a: u32, b: u32, la: u32, lb: u32, ca: u32, cb: u32) -> Event {
+    if a < b {
+        Event {
+            t,
+            a,
+            b,
+            la,
+            lb,
+            ca,
+            cb,
+        }
+    } else {
+        Event {
+            t,
+            a: b,
+            b: a,
+            la: lb,
+            lb: la,
+            ca: cb,
+            cb: ca,
+        }
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn push_wall(
+    heap: &mut BinaryHeap<Event>,
+    s: &Sphere,
+    a: u32,
+    la: u32,
+    t: f64,
+    ca: u32,
+    size: f64,
+    dt: f64,
+) {
+    let (tw, _) = wall_toi(s, size);
+    if t + tw <= dt {
+        heap.push(Event {
+            t: t + tw,
+            a,
+            b: NONE,
+            la,
+            lb: NONE,
+            ca,
+            cb: 0,
+        });
+    }
+}

@@ -1,0 +1,508 @@
+//! The contact events of a step, cut into clusters that run side by side.
+//!
+//! The spheres with an event (a pair that meets, or a wall) are grouped:
+//! pairs that meet, and pairs of such spheres whose balls for the step
+//! overlap, end up in one cluster. Each cluster runs the serial event loop
+//! on its own (`cluster::Run`), on any lane. A run that finds it may touch
+//! a sphere outside its cluster stops; so do two clusters whose balls grew
+//! into each other. Those are merged (an outsider with no event joins) and
+//! run again, until a round ends with no conflict. After a few parallel
+//! rounds the rest run as one cluster that takes outsiders in as it meets
+//! them, which is the plain serial event loop; on one lane that is all
+//! there is.
+//!
+//! The result is the serial loop's, bit for bit, however the clusters fall
+//! and whatever runs them: clusters that cannot touch each other have no
+//! events in common, events within one are taken in the same order (ties by
+//! sphere id), and totals are summed in sphere order.
+use super::cluster::{Member, Run, Shared};
+use super::{NONE, path_ball};
+use crate::physics::broad::Grid;
+use crate::physics::exec::{Exec, Serial, lane_blocks};
+use crate::physics::sphere::Sphere;
+use crate::physics::world::Counters;
+use glam::DVec3;
+use parking_lot::Mutex;
+
+/// Clusters per parallel block.
+const CLUSTER_BLOCK: usize = 16;
+/// Rounds run in parallel before the rest run as one absorbing cluster.
+const PARALLEL_ROUNDS: usize = 8;
+
+/// What one block of clusters left.
+#[derive(Default)]
+struct BlockOut {
+    /// Finished clusters: (capped, how many of `members` are theirs).
+    done: Vec<(bool, u32)>,
+    members: Vec<Member>,
+    /// (a member, the outsider it may touch).
+    conflicts: Vec<(u32, u32)>,
+}
+
+/// How a step's events were cut, for benches and tests.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RoundStats {
+    /// Clusters of the first round.
+    pub clusters: usize,
+    pub rounds: usize,
+    /// Cluster runs after the first round.
+    pub reruns: usize,
+}
+
+/// A cluster to run: its root slot, members `order[m0..m1]`, meeting pairs
+/// `pairs[p0..p1]`.
+#[derive(Clone, Copy)]
+struct Todo {
+    root: u32,
+    m0: u32,
+    m1: u32,
+    p0: u32,
+    p1: u32,
+}
+
+#[derive(Default)]
+pub(super) struct Rounds {
+    /// Sphere id → slot among the involved, NONE for the rest.
+    slot: Vec<u32>,
+    /// Slot → sphere id.
+    ids: Vec<u32>,
+    /// Slots from here on were added after the first round.
+    first_late: usize,
+    parent: Vec<u32>,
+    /// By root slot: the cluster must run (again).
+    dirty: Vec<bool>,
+    /// By slot: the member's result from its cluster's last finished run.
+    out: Vec<Option<Member>>,
+    capped: Vec<bool>,
+    /// Slot → root slot, fixed during a round (the cluster's name).
+    cluster_of: Vec<u32>,
+    starts: Vec<u32>,
+    order: Vec<u32>,
+    pair_starts: Vec<u32>,
+    pairs: Vec<(u32, u32)>,
+    todo: Vec<Todo>,
+    /// One run's scratch per lane, one output per block.
+    runs: Vec<Mutex<Run>>,
+    outs: Vec<Mutex<BlockOut>>,
+    conflicts: Vec<(u32, u32)>,
+    /// Balls of the grown and late spheres, and a grid to find which meet.
+    grown_slots: Vec<u32>,
+    balls: Vec<Sphere>,
+    overlap: Grid,
+    overlap_pairs: Vec<(u32, u32)>,
+    pub stats: RoundStats,
+    /// Run every step as one absorbing cluster (the plain serial loop),
+    /// whatever the lanes.
+    pub serial_only: bool,
+}
+
+impl Rounds {
+    /// Whether sphere `i` had an event in the last `run`.
+    #[inline]
+    pub fn involved(&self, i: usize) -> bool {
+        self.slot[i] != NONE
+    }
+
+    /// Runs the events of a step: `meets` are the pairs whose straight paths
+    /// meet within `dt`, `near` pairs whose balls overlap but do not meet,
+    /// `hits` the spheres that reach a wall. Leaves every involved sphere
+    /// at the end of the step in `spheres` and adds to `counters`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn run(
+        &mut self,
+        exec: &dyn Exec,
+        spheres: &mut [Sphere],
+        grid: &Grid,
+        size: f64,
+        dt: f64,
+        meets: &[(u32, u32)],
+        near: &[(u32, u32)],
+        hits: &[u32],
+        counters: &mut Counters,
+    ) {
+        let serial = self.serial_only || exec.lanes() < 2;
+        self.start(spheres.len(), meets, near, hits, serial);
+        let mut round = 0;
+        loop {
+            let absorb = serial || round >= PARALLEL_ROUNDS;
+            if absorb {
+                self.merge_dirty();
+            }
+            self.partition(meets);
+            if self.todo.is_empty() {
+                break;
+            }
+            self.stats.rounds += 1;
+            if round == 0 {
+                self.stats.clusters = self.todo.len();
+            } else {
+                self.stats.reruns += self.todo.len();
+            }
+            let exec: &dyn Exec = if absorb { &Serial } else { exec };
+            self.reserve(exec);
+            let sh = Shared {
+                spheres,
+                grid,
+                slot: &self.slot,
+                cluster_of: &self.cluster_of,
+                size,
+                dt,
+            };
+            self.run_clusters(exec, &sh, absorb);
+            self.collect();
+            // Grown balls are compared once the runs agree, not every round.
+            if self.conflicts.is_empty() {
+                self.check_grown(exec, spheres, size, dt);
+            }
+            if self.conflicts.is_empty() {
+                break;
+            }
+            self.merge_conflicts();
+            round += 1;
+        }
+        self.write_back(spheres, counters);
+    }
+
+    fn start(
+        &mut self,
+        n: usize,
+        meets: &[(u32, u32)],
+        near: &[(u32, u32)],
+        hits: &[u32],
+        serial: bool,
+    ) {
+        for &i in &self.ids {
+            self.slot[i as usize] = NONE;
+        }
+        self.slot.resize(n, NONE);
+        self.ids.clear();
+        self.ids.extend(meets.iter().flat_map(|&(i, j)| [i, j]));
+        self.ids.extend_from_slice(hits);
+        self.ids.sort_unstable();
+        self.ids.dedup();
+        for (k, &i) in self.ids.iter().enumerate() {
+            self.slot[i as usize] = k as u32;
+        }
+        let m = self.ids.len();
+        self.first_late = m;
+        self.parent.clear();
+        self.parent.extend(0..m as u32);
+        self.dirty.clear();
+        self.dirty.resize(m, true);
+        self.out.clear();
+        self.out.resize(m, None);
+        self.capped.clear();
+        self.capped.resize(m, false);
+        self.stats = RoundStats::default();
+        if serial {
+            // One cluster: every slot's parent is slot 0.
+            self.parent.fill(0);
+            return;
+        }
+        for &(i, j) in meets {
+            self.union(self.slot[i as usize], self.slot[j as usize]);
+        }
+        for &(i, j) in near {
+            let (a, b) = (self.slot[i as usize], self.slot[j as usize]);
+            if a != NONE && b != NONE {
+                self.union(a, b);
+            }
+        }
+    }
+
+    fn find(&mut self, mut x: u32) -> u32 {
+        while self.parent[x as usize] != x {
+            let p = self.parent[x as usize];
+            self.parent[x as usize] = self.parent[p as usize];
+            x = p;
+        }
+        x
+    }
+
+    /// Joins two slots' clusters; the joined cluster must run again.
+    fn union(&mut self, a: u32, b: u32) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        let (lo, hi) = (ra.min(rb), ra.max(rb));
+        self.parent[hi as usize] = lo;
+        self.dirty[lo as usize] = true;
+    }
+
+    fn add_slot(&mut self, id: u32) -> u32 {
+        let k = self.ids.len() as u32;
+        self.slot[id as usize] = k;
+        self.ids.push(id);
+        self.parent.push(k);
+        self.dirty.push(true);
+        self.out.push(None);
+        self.capped.push(false);
+        k
+    }
+
+    /// Every cluster that must run again, as one.
+    fn merge_dirty(&mut self) {
+        let mut first = NONE;
+        for s in 0..self.ids.len() as u32 {
+            let r = self.find(s);
+            if self.dirty[r as usize] && r != first {
+                if first == NONE {
+                    first = r;
+                } else {
+                    self.union(first, r);
+                    first = self.find(first);
+                }
+            }
+        }
+    }
+
+    /// This round's clusters (named by root slot) and the ones that must
+    /// run, with their members and meeting pairs, grouped by counting sort.
+    fn partition(&mut self, meets: &[(u32, u32)]) {
+        let m = self.ids.len();
+        self.cluster_of.resize(m, NONE);
+        for s in 0..m as u32 {
+            let r = self.find(s);
+            self.cluster_of[s as usize] = r;
+        }
+        let (cluster_of, dirty, slot, ids) = (&self.cluster_of, &self.dirty, &self.slot, &self.ids);
+        let member_roots = (0..m).filter_map(|s| {
+            let r = cluster_of[s];
+            dirty[r as usize].then_some((r, ids[s]))
+        });
+        group(&mut self.starts, &mut self.order, m, member_roots);
+        let pair_roots = meets.iter().filter_map(|&(i, j)| {
+            let r = cluster_of[slot[i as usize] as usize];
+            dirty[r as usize].then_some((r, (i, j)))
+        });
+        group(&mut self.pair_starts, &mut self.pairs, m, pair_roots);
+        self.todo.clear();
+        for r in 0..m {
+            let (m0, m1) = (self.starts[r], self.starts[r + 1]);
+            if m1 > m0 {
+                self.todo.push(Todo {
+                    root: r as u32,
+                    m0,
+                    m1,
+                    p0: self.pair_starts[r],
+                    p1: self.pair_starts[r + 1],
+                });
+            }
+        }
+    }
+
+    /// Scratch for `run_clusters` on `exec`.
+    fn reserve(&mut self, exec: &dyn Exec) {
+        let blocks = self.todo.len().div_ceil(CLUSTER_BLOCK);
+        while self.runs.len() < exec.lanes() {
+            self.runs.push(Mutex::new(Run::default()));
+        }
+        while self.outs.len() < blocks {
+            self.outs.push(Mutex::new(BlockOut::default()));
+        }
+    }
+
+    fn run_clusters(&self, exec: &dyn Exec, sh: &Shared, absorb: bool) {
+        let blocks = self.todo.len().div_ceil(CLUSTER_BLOCK);
+        let lanes = exec.lanes().clamp(1, blocks.max(1));
+        let (runs, outs, todo) = (&self.runs, &self.outs, &self.todo);
+        let (order, pairs) = (&self.order, &self.pairs);
+        exec.for_each_lane(&|lane| {
+            if lane >= lanes {
+                return;
+            }
+            let mut run = runs[lane].lock();
+            for b in lane_blocks(blocks, lane, lanes) {
+                let mut out = outs[b].lock();
+                out.done.clear();
+                out.members.clear();
+                out.conflicts.clear();
+                let end = ((b + 1) * CLUSTER_BLOCK).min(todo.len());
+                for t in &todo[b * CLUSTER_BLOCK..end] {
+                    let members = &order[t.m0 as usize..t.m1 as usize];
+                    let cp = &pairs[t.p0 as usize..t.p1 as usize];
+                    if run.run(sh, t.root, members, cp, absorb) {
+                        let before = out.members.len();
+                        out.members.extend(run.members());
+                        let len = (out.members.len() - before) as u32;
+                        out.done.push((run.capped, len));
+                    } else {
+                        let first = members[0];
+                        out.conflicts
+                            .extend(run.conflicts.iter().map(|&j| (first, j)));
+                    }
+                }
+            }
+        });
+    }
+
+    /// Results of the runs just made: finished clusters' members go to
+    /// their slots; conflicts are kept for merging.
+    fn collect(&mut self) {
+        self.conflicts.clear();
+        let outs = std::mem::take(&mut self.outs);
+        for block in &outs[..self.todo.len().div_ceil(CLUSTER_BLOCK)] {
+            let out = block.lock();
+            let mut k = 0usize;
+            for &(capped, len) in &out.done {
+                let members = &out.members[k..k + len as usize];
+                k += len as usize;
+                // A run that took outsiders in (the absorbing round) has them
+                // as members now.
+                let mut root = NONE;
+                for m in members {
+                    let s = match self.slot[m.id as usize] {
+                        NONE => self.add_slot(m.id),
+                        s => s,
+                    };
+                    self.out[s as usize] = Some(*m);
+                    self.capped[s as usize] = capped;
+                    let r = self.find(s);
+                    if root == NONE {
+                        root = r;
+                    } else if r != root {
+                        let (lo, hi) = (r.min(root), r.max(root));
+                        self.parent[hi as usize] = lo;
+                        root = lo;
+                    }
+                }
+                self.dirty[root as usize] = false;
+            }
+            self.conflicts.extend_from_slice(&out.conflicts);
+        }
+        self.outs = outs;
+    }
+
+    /// A finished cluster whose member's ball grew was checked against the
+    /// balls the grid holds, of spheres that had events then. Two such
+    /// grown balls, or a grown ball and a sphere that got events later (its
+    /// path no longer straight), may meet where no run could see it: such
+    /// pairs in different clusters conflict too.
+    fn check_grown(&mut self, exec: &dyn Exec, spheres: &[Sphere], size: f64, dt: f64) {
+        self.grown_slots.clear();
+        self.balls.clear();
+        let mut any_grew = false;
+        for s in 0..self.ids.len() {
+            let grew = self.out[s].is_some_and(|m| m.grew);
+            any_grew |= grew;
+            if grew || s >= self.first_late {
+                let (centre, reach) = self.ball(s, spheres, dt);
+                self.grown_slots.push(s as u32);
+                self.balls.push(Sphere {
+                    pos: centre,
+                    vel: DVec3::ZERO,
+                    radius: reach,
+                    mass: 0.0,
+                });
+            }
+        }
+        if !any_grew || self.balls.len() < 2 {
+            return;
+        }
+        // The absorbing round joins clusters: name them afresh.
+        self.cluster_of.resize(self.ids.len(), NONE);
+        for s in 0..self.ids.len() as u32 {
+            let r = self.find(s);
+            self.cluster_of[s as usize] = r;
+        }
+        self.overlap
+            .build(&self.balls, size, |b| (b.pos, b.radius), exec);
+        let mut pairs = std::mem::take(&mut self.overlap_pairs);
+        let (out, slots, cluster_of) = (&self.out, &self.grown_slots, &self.cluster_of);
+        let grew = |k: u32| out[slots[k as usize] as usize].is_some_and(|m| m.grew);
+        let apart = |a: u32, b: u32| {
+            let (sa, sb) = (slots[a as usize] as usize, slots[b as usize] as usize);
+            (grew(a) || grew(b)) && cluster_of[sa] != cluster_of[sb]
+        };
+        self.overlap.pairs(exec, &apart, &mut pairs);
+        for &(a, b) in &pairs {
+            let (sa, sb) = (self.grown_slots[a as usize], self.grown_slots[b as usize]);
+            self.conflicts
+                .push((self.ids[sa as usize], self.ids[sb as usize]));
+        }
+        self.overlap_pairs = pairs;
+    }
+
+    /// The ball slot `s`'s path stays in: from its last finished run, or
+    /// its straight path.
+    fn ball(&self, s: usize, spheres: &[Sphere], dt: f64) -> (DVec3, f64) {
+        match &self.out[s] {
+            Some(m) => (m.centre, m.reach),
+            None => path_ball(&spheres[self.ids[s] as usize], dt),
+        }
+    }
+
+    fn merge_conflicts(&mut self) {
+        let conflicts = std::mem::take(&mut self.conflicts);
+        for &(a, j) in &conflicts {
+            let sj = match self.slot[j as usize] {
+                NONE => self.add_slot(j),
+                s => s,
+            };
+            self.union(self.slot[a as usize], sj);
+        }
+        self.conflicts = conflicts;
+    }
+
+    fn write_back(&mut self, spheres: &mut [Sphere], counters: &mut Counters) {
+        let mut any_capped = false;
+        for (s, m) in self.out.iter().enumerate() {
+            let m = m.expect("every involved sphere finished");
+            spheres[m.id as usize] = m.sphere;
+            counters.sphere_collisions += m.pair_hits as u64;
+            counters.wall_collisions += m.wall_hits as u64;
+            any_capped |= self.capped[s];
+        }
+        // The wall momentum is summed in sphere order, however the rounds
+        // went: the first slots are in id order, the late ones are merged in.
+        let mut late: Vec<(u32, f64)> = self.out[self.first_late..]
+            .iter()
+            .map(|m| m.map(|m| (m.id, m.wall_momentum)).expect("finished"))
+            .collect();
+        late.sort_unstable_by_key(|&(id, _)| id);
+        let mut late = late.into_iter().peekable();
+        for m in self.out[..self.first_late].iter().flatten() {
+            while let Some(&(id, p)) = late.peek()
+                && id < m.id
+            {
+                counters.wall_momentum += p;
+                late.next();
+            }
+            counters.wall_momentum += m.wall_momentum;
+        }
+        for (_, p) in late {
+            counters.wall_momentum += p;
+        }
+        if any_capped {
+            counters.capped_steps += 1;
+        }
+    }
+}
+
+/// Groups `items` by key in `0..keys`, keeping their order within a key:
+/// `out[starts[k]..starts[k + 1]]` are the items of key `k`.
+fn group<T: Copy + Default>(
+    starts: &mut Vec<u32>,
+    out: &mut Vec<T>,
+    keys: usize,
+    items: impl Iterator<Item = (u32, T)> + Clone,
+) {
+    starts.clear();
+    starts.resize(keys + 1, 0);
+    for (k, _) in items.clone() {
+        starts[k as usize + 1] += 1;
+    }
+    for k in 0..keys {
+        starts[k + 1] += starts[k];
+    }
+    out.clear();
+    out.resize(starts[keys] as usize, T::default());
+    for (k, v) in items {
+        let at = &mut starts[k as usize];
+        out[*at as usize] = v;
+        *at += 1;
+    }
+    // Placing moved each start to the next key's; shift back.
+    for k in (1..=keys).rev() {
+        starts[k] = starts[k - 1];
+    }
+    starts[0] = 0;
+}

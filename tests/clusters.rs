@@ -1,0 +1,75 @@
+//! `swept` runs a step's contact events in clusters, side by side; the
+//! result must be the plain serial event loop's, bit for bit, on every kind
+//! of scene, however many lanes run the clusters.
+use ballpit::physics::swept::Swept;
+use ballpit::physics::{Exec, Model, Serial, World};
+use ballpit::scene::{SceneSpec, build_world};
+
+/// Lanes run one after another, last first.
+struct Lanes(usize);
+
+impl Exec for Lanes {
+    fn lanes(&self) -> usize {
+        self.0
+    }
+    fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
+        (0..self.0).rev().for_each(f)
+    }
+    fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {
+        b();
+        a();
+    }
+}
+
+fn world(scene: &str, count: usize, speed: Option<f64>) -> World {
+    build_world(&SceneSpec {
+        scene: Some(scene.into()),
+        count: Some(count),
+        speed,
+        seed: Some(11),
+        ..Default::default()
+    })
+    .unwrap()
+}
+
+#[test]
+fn clusters_match_the_serial_event_loop() {
+    for (scene, count, speed, steps) in [
+        ("gas", 4000, Some(2.0), 20),
+        ("dense", 1500, None, 10),
+        ("mixed", 400, None, 20),
+        ("projectiles", 200, None, 20),
+        ("cradle", 5, None, 60),
+        ("billiards", 16, None, 60),
+    ] {
+        let start = world(scene, count, speed);
+        let e0 = start.kinetic_energy();
+        let mut reference = start.clone();
+        let mut serial = Swept::default().serial_events(true);
+        serial.advance(&mut reference, 1.0 / 60.0, steps, &Serial);
+        for lanes in [1, 2, 3] {
+            let mut w = start.clone();
+            let mut m = Swept::default();
+            let (mut clusters, mut reruns, mut rounds) = (0, 0, 0);
+            for _ in 0..steps {
+                m.advance(&mut w, 1.0 / 60.0, 1, &Lanes(lanes));
+                let s = m.round_stats();
+                clusters += s.clusters;
+                reruns += s.reruns;
+                rounds = rounds.max(s.rounds);
+            }
+            assert_eq!(w, reference, "{scene}: clusters on {lanes} lanes");
+            if count >= 1000 && lanes > 1 {
+                assert!(
+                    clusters > 10 * steps as usize,
+                    "{scene}: {clusters} clusters"
+                );
+            }
+            eprintln!("{scene}: {clusters} clusters, {reruns} reruns, up to {rounds} rounds");
+        }
+        assert!(reference.counters.sphere_collisions > 0, "{scene}");
+        assert_eq!(reference.escaped(), 0, "{scene}");
+        let drift = (reference.kinetic_energy() - e0).abs() / e0;
+        assert!(drift < 1e-12, "{scene}: energy drift {drift:e}");
+    }
+}
