@@ -2,6 +2,7 @@
 //! thread: the engine hands it an `Exec`, and the physics cuts its work into
 //! fixed-size blocks whose results are combined in block order, so the answer
 //! is bit-identical whatever the executor and however many lanes it has.
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Runs work the physics hands it.
 pub trait Exec: Sync {
@@ -36,13 +37,6 @@ impl Exec for Serial {
     }
 }
 
-/// The block range lane `lane` of `lanes` takes out of `blocks` blocks.
-pub fn lane_blocks(blocks: usize, lane: usize, lanes: usize) -> std::ops::Range<usize> {
-    let per = blocks.div_ceil(lanes.max(1));
-    let start = (lane * per).min(blocks);
-    start..(start + per).min(blocks)
-}
-
 /// Run `f(block, chunk)` for `data` cut into chunks of `block` items, the
 /// chunks spread over lanes.
 pub fn for_each_chunk<T: Send>(
@@ -59,15 +53,26 @@ pub fn for_each_chunk<T: Send>(
 }
 
 /// Run `f(block)` for every block in `0..blocks`, blocks spread over lanes.
+/// Lanes take the next block as they finish one, so uneven blocks even out;
+/// each block's result is its own, so who ran it never shows.
 pub fn for_each_block(exec: &dyn Exec, blocks: usize, f: &(dyn Fn(usize) + Sync)) {
     let lanes = exec.lanes().min(blocks).max(1);
     if lanes == 1 {
         (0..blocks).for_each(f);
         return;
     }
+    let next = AtomicUsize::new(0);
     exec.for_each_lane(&|lane| {
         if lane < lanes {
-            lane_blocks(blocks, lane, lanes).for_each(f);
+            next_blocks(&next, blocks).for_each(f);
         }
     });
+}
+
+/// The blocks one lane takes from a shared counter, until none are left.
+pub fn next_blocks(next: &AtomicUsize, blocks: usize) -> impl Iterator<Item = usize> + '_ {
+    std::iter::from_fn(move || {
+        let b = next.fetch_add(1, Ordering::Relaxed);
+        (b < blocks).then_some(b)
+    })
 }

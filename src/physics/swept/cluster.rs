@@ -15,14 +15,12 @@ use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 /// What every run of a step reads: the state at the start of the step and
-/// this round's partition.
+/// who has events.
 pub(super) struct Shared<'a> {
     pub spheres: &'a [Sphere],
     pub grid: &'a Grid,
     /// Sphere id → its slot among the involved spheres, or NONE.
     pub slot: &'a [u32],
-    /// Slot → cluster of this round.
-    pub cluster_of: &'a [u32],
     pub size: f64,
     pub dt: f64,
 }
@@ -83,13 +81,9 @@ pub(super) struct Member {
 #[derive(Default)]
 pub(super) struct Run {
     ids: Vec<u32>,
-    /// Slot → local index for members with a slot, NONE otherwise; kept
-    /// all NONE between runs.
-    local_of_slot: Vec<u32>,
-    /// Outsiders taken in (sphere ids), and sphere id → local index for
-    /// them (NONE otherwise; sized to the spheres once a run absorbs).
-    taken: Vec<u32>,
-    taken_local: Vec<u32>,
+    /// Sphere id → local index for members, NONE for everyone else; kept
+    /// so between runs (one lookup per candidate, the hot path).
+    local_of: Vec<u32>,
     sp: Vec<Sphere>,
     t_local: Vec<f64>,
     count: Vec<u32>,
@@ -113,7 +107,7 @@ pub(super) struct Run {
 }
 
 impl Run {
-    /// Runs the events of cluster `c` (its `members` and the
+    /// Runs the events of a cluster (its `members` and the
     /// `pairs` detection found among them); true when it is valid (no
     /// conflicts). With `absorb`, a sphere outside every cluster that a
     /// member meets joins this run instead of conflicting (safe only when
@@ -121,35 +115,26 @@ impl Run {
     pub fn run(
         &mut self,
         sh: &Shared,
-        c: u32,
         members: &[u32],
         pairs: &[(u32, u32)],
         absorb: bool,
     ) -> bool {
-        self.clear(sh.cluster_of.len());
+        self.clear(sh.spheres.len());
         for &i in members {
-            let l = self.involve(sh, i);
-            self.local_of_slot[sh.slot[i as usize] as usize] = l;
+            self.involve(sh, i);
         }
-        self.events(sh, c, pairs, absorb);
+        self.events(sh, pairs, absorb);
         for &i in &self.ids {
-            let s = sh.slot[i as usize];
-            if s != NONE {
-                self.local_of_slot[s as usize] = NONE;
-            }
-        }
-        for &i in &self.taken {
-            self.taken_local[i as usize] = NONE;
+            self.local_of[i as usize] = NONE;
         }
         self.conflicts.sort_unstable();
         self.conflicts.dedup();
         self.conflicts.is_empty()
     }
 
-    fn events(&mut self, sh: &Shared, c: u32, pairs: &[(u32, u32)], absorb: bool) {
+    fn events(&mut self, sh: &Shared, pairs: &[(u32, u32)], absorb: bool) {
         for &(i, j) in pairs {
-            let a = self.local_of_slot[sh.slot[i as usize] as usize];
-            let b = self.local_of_slot[sh.slot[j as usize] as usize];
+            let (a, b) = (self.local_of[i as usize], self.local_of[j as usize]);
             let (si, sj) = (&self.sp[a as usize], &self.sp[b as usize]);
             if let Some(t) = pair_toi(si.pos - sj.pos, si.vel - sj.vel, si.radius + sj.radius) {
                 self.heap.push(pair_event(t, i, j, a, b, 0, 0));
@@ -174,7 +159,7 @@ impl Run {
                 let (imp, hits) = reflect_walls(&mut self.sp[la], mask);
                 self.wall_momentum[la] += imp;
                 self.wall_hits[la] += hits as u32;
-                self.rescan(sh, c, la, e.t, absorb);
+                self.rescan(sh, la, e.t, absorb);
             } else {
                 self.advance_to(lb, e.t);
                 self.count[lb] += 1;
@@ -182,8 +167,8 @@ impl Run {
                 if resolve_pair(x, y) {
                     self.pair_hits[la.min(lb)] += 1;
                 }
-                self.rescan(sh, c, la, e.t, absorb);
-                self.rescan(sh, c, lb, e.t, absorb);
+                self.rescan(sh, la, e.t, absorb);
+                self.rescan(sh, lb, e.t, absorb);
             }
         }
         for l in 0..self.ids.len() {
@@ -214,12 +199,11 @@ impl Run {
         })
     }
 
-    fn clear(&mut self, slots: usize) {
-        if self.local_of_slot.len() < slots {
-            self.local_of_slot.resize(slots, NONE);
+    fn clear(&mut self, n: usize) {
+        if self.local_of.len() < n {
+            self.local_of.resize(n, NONE);
         }
         self.ids.clear();
-        self.taken.clear();
         self.sp.clear();
         self.t_local.clear();
         self.count.clear();
@@ -236,21 +220,10 @@ impl Run {
         self.conflicts.clear();
     }
 
-    /// Local index of sphere `j` if it is a member of this run (cluster
-    /// `c`).
+    /// Local index of sphere `j` if it is a member of this run.
     #[inline(always)]
-    fn member(&self, sh: &Shared, c: u32, j: u32) -> Option<usize> {
-        let s = sh.slot[j as usize];
-        if s != NONE {
-            if sh.cluster_of[s as usize] == c {
-                return Some(self.local_of_slot[s as usize] as usize);
-            }
-            return None;
-        }
-        if self.taken.is_empty() {
-            return None;
-        }
-        match self.taken_local[j as usize] {
+    fn member(&self, j: u32) -> Option<usize> {
+        match self.local_of[j as usize] {
             NONE => None,
             l => Some(l as usize),
         }
@@ -261,6 +234,7 @@ impl Run {
     fn involve(&mut self, sh: &Shared, i: u32) -> u32 {
         let l = self.ids.len() as u32;
         let s = sh.spheres[i as usize];
+        self.local_of[i as usize] = l;
         self.ids.push(i);
         self.sp.push(s);
         self.t_local.push(0.0);
@@ -287,7 +261,7 @@ impl Run {
     /// Member `la` changed velocity at `t`: widen its ball if its new path
     /// needs it, and schedule its next wall and every member it can now meet
     /// before the step ends. Anyone else it might meet is a conflict.
-    fn rescan(&mut self, sh: &Shared, c: u32, la: usize, t: f64, absorb: bool) {
+    fn rescan(&mut self, sh: &Shared, la: usize, t: f64, absorb: bool) {
         let sa = self.sp[la];
         let ia = self.ids[la];
         let need =
@@ -311,7 +285,7 @@ impl Run {
             // Outsiders are judged by the ball the grid holds for them: a
             // run never reads another run's state.
             let mut consider = |j: u32, pj0: DVec3, rj: f64| {
-                let rj = this.member(sh, c, j).map_or(rj, |l| this.reach[l]);
+                let rj = this.member(j).map_or(rj, |l| this.reach[l]);
                 if p0.distance_squared(pj0) <= (ra + rj) * (ra + rj) {
                     found.push(j);
                 }
@@ -328,7 +302,7 @@ impl Run {
             if j == ia {
                 continue;
             }
-            let l = self.member(sh, c, j);
+            let l = self.member(j);
             if l.is_none() && sh.slot[j as usize] != NONE {
                 // A member of another cluster whose ball meets ours: its path
                 // is not known here.
@@ -359,15 +333,7 @@ impl Run {
             }
             let lb = match l {
                 Some(l) => l as u32,
-                None if absorb => {
-                    let l = self.involve(sh, j);
-                    if self.taken_local.len() < sh.spheres.len() {
-                        self.taken_local.resize(sh.spheres.len(), NONE);
-                    }
-                    self.taken.push(j);
-                    self.taken_local[j as usize] = l;
-                    l
-                }
+                None if absorb => self.involve(sh, j),
                 None => {
                     self.conflicts.push(j);
                     continue;

@@ -18,7 +18,8 @@
 use super::cluster::{Member, Run, Shared};
 use super::{NONE, path_ball};
 use crate::physics::broad::Grid;
-use crate::physics::exec::{Exec, Serial, lane_blocks};
+use crate::physics::exec::{Exec, Serial, next_blocks};
+use std::sync::atomic::AtomicUsize;
 use crate::physics::sphere::Sphere;
 use crate::physics::world::Counters;
 use glam::DVec3;
@@ -49,11 +50,10 @@ pub struct RoundStats {
     pub reruns: usize,
 }
 
-/// A cluster to run: its root slot, members `order[m0..m1]`, meeting pairs
+/// A cluster to run: members `order[m0..m1]`, meeting pairs
 /// `pairs[p0..p1]`.
 #[derive(Clone, Copy)]
 struct Todo {
-    root: u32,
     m0: u32,
     m1: u32,
     p0: u32,
@@ -144,7 +144,6 @@ impl Rounds {
                 spheres,
                 grid,
                 slot: &self.slot,
-                cluster_of: &self.cluster_of,
                 size,
                 dt,
             };
@@ -279,7 +278,6 @@ impl Rounds {
             let (m0, m1) = (self.starts[r], self.starts[r + 1]);
             if m1 > m0 {
                 self.todo.push(Todo {
-                    root: r as u32,
                     m0,
                     m1,
                     p0: self.pair_starts[r],
@@ -305,12 +303,13 @@ impl Rounds {
         let lanes = exec.lanes().clamp(1, blocks.max(1));
         let (runs, outs, todo) = (&self.runs, &self.outs, &self.todo);
         let (order, pairs) = (&self.order, &self.pairs);
+        let next = AtomicUsize::new(0);
         exec.for_each_lane(&|lane| {
             if lane >= lanes {
                 return;
             }
             let mut run = runs[lane].lock();
-            for b in lane_blocks(blocks, lane, lanes) {
+            for b in next_blocks(&next, blocks) {
                 let mut out = outs[b].lock();
                 out.done.clear();
                 out.members.clear();
@@ -319,7 +318,7 @@ impl Rounds {
                 for t in &todo[b * CLUSTER_BLOCK..end] {
                     let members = &order[t.m0 as usize..t.m1 as usize];
                     let cp = &pairs[t.p0 as usize..t.p1 as usize];
-                    if run.run(sh, t.root, members, cp, absorb) {
+                    if run.run(sh, members, cp, absorb) {
                         let before = out.members.len();
                         out.members.extend(run.members());
                         let len = (out.members.len() - before) as u32;
