@@ -19,11 +19,11 @@ use super::cluster::{Member, Run, Shared};
 use super::{NONE, path_ball};
 use crate::physics::broad::Grid;
 use crate::physics::exec::{Exec, Serial, next_blocks};
-use std::sync::atomic::AtomicUsize;
 use crate::physics::sphere::Sphere;
 use crate::physics::world::Counters;
 use glam::DVec3;
 use parking_lot::Mutex;
+use std::sync::atomic::AtomicUsize;
 
 /// Clusters per parallel block.
 const CLUSTER_BLOCK: usize = 16;
