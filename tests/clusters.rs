@@ -73,3 +73,41 @@ fn clusters_match_the_serial_event_loop() {
         assert!(drift < 1e-12, "{scene}: energy drift {drift:e}");
     }
 }
+
+/// The engine asks `swept` for the overlap of the world a frame ended with;
+/// the model answers from the next step's detection and reuses it for that
+/// step. The answer is `World::max_overlap_rel`'s, and asking changes
+/// nothing in the run.
+#[test]
+fn overlap_from_the_next_detection_matches_the_world() {
+    use ballpit::physics::ModelKind;
+    // Discrete steps leave overlaps to measure.
+    let mut w = world("dense", 1500, None);
+    ModelKind::Discrete
+        .build()
+        .advance(&mut w, 1.0 / 60.0, 5, &Serial);
+    let deepest = w.max_overlap_rel();
+    assert!(deepest > 1e-3, "discrete left overlaps: {deepest}");
+    let (mut asked, mut plain) = (w.clone(), w.clone());
+    let (mut m_asked, mut m_plain) = (Swept::default(), Swept::default());
+    for k in 0..12 {
+        let got = m_asked
+            .max_overlap_rel(&asked, 1.0 / 60.0, &Lanes(2))
+            .expect("swept knows");
+        assert_eq!(got, asked.max_overlap_rel(), "frame {k}");
+        // Asked twice, still right (and the detection kept).
+        let again = m_asked.max_overlap_rel(&asked, 1.0 / 60.0, &Serial);
+        assert_eq!(again, Some(got));
+        m_asked.advance(&mut asked, 1.0 / 60.0, 1, &Lanes(2));
+        m_plain.advance(&mut plain, 1.0 / 60.0, 1, &Serial);
+        assert_eq!(asked, plain, "frame {k}");
+    }
+    // A world changed behind the model's back is detected afresh.
+    let mut moved = asked.clone();
+    m_asked.max_overlap_rel(&asked, 1.0 / 60.0, &Serial);
+    moved.spheres[0].vel *= -1.0;
+    let mut reference = moved.clone();
+    m_asked.advance(&mut moved, 1.0 / 60.0, 1, &Serial);
+    Swept::default().advance(&mut reference, 1.0 / 60.0, 1, &Serial);
+    assert_eq!(moved, reference);
+}

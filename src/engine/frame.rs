@@ -48,7 +48,12 @@ impl Frame {
         let physics_seconds = t0.elapsed().as_secs_f64();
         self.number += 1;
         let snap = &mut self.snap;
-        snap.fill_world(&self.world, &mut self.scratch, &*self.exec);
+        snap.fill_world(
+            &self.world,
+            Some((&mut *self.model, self.settings.dt)),
+            &mut self.scratch,
+            &*self.exec,
+        );
         snap.frame = self.number;
         snap.energy_reset = self.energy_reset;
         snap.physics_seconds = physics_seconds;

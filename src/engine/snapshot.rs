@@ -2,10 +2,16 @@
 //! one the renderer reads while the physics fills the back one.
 use super::Settings;
 use crate::physics::broad::{Grid, Pair};
-use crate::physics::{Counters, Exec, World};
+use crate::physics::exec::for_each_chunk;
+use crate::physics::world::escapes;
+use crate::physics::{Counters, Exec, Model, World};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Spheres per parallel block when copying them out.
+const VIEW_BLOCK: usize = 8192;
 
 /// What the screen needs of one sphere.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SphereView {
     pub pos: [f64; 3],
     pub radius: f64,
@@ -55,6 +61,7 @@ impl Snapshot {
         };
         s.fill_world(
             world,
+            None,
             &mut OverlapScratch::default(),
             &crate::physics::Serial,
         );
@@ -65,21 +72,37 @@ impl Snapshot {
     pub(crate) fn fill_world(
         &mut self,
         world: &World,
+        model: Option<(&mut dyn Model, f64)>,
         scratch: &mut OverlapScratch,
         exec: &dyn Exec,
     ) {
         self.time = world.time;
         self.size = world.size;
-        self.spheres.clear();
-        self.spheres
-            .extend(world.spheres.iter().map(|s| SphereView {
-                pos: s.pos.to_array(),
-                radius: s.radius,
-                speed: s.vel.length(),
-            }));
+        // The copy and the escape count run on the frame's executor: at
+        // 100 000 spheres they would otherwise be a serial tail on every
+        // frame of a parallel mode.
+        let sp = &world.spheres;
+        self.spheres.resize(sp.len(), SphereView::default());
+        let escaped = AtomicUsize::new(0);
+        let tol = 1e-9 * world.size;
+        for_each_chunk(exec, &mut self.spheres, VIEW_BLOCK, &|b, chunk| {
+            let mut out = 0;
+            for (v, s) in chunk.iter_mut().zip(&sp[b * VIEW_BLOCK..]) {
+                *v = SphereView {
+                    pos: s.pos.to_array(),
+                    radius: s.radius,
+                    speed: s.vel.length(),
+                };
+                out += usize::from(escapes(s, world.size, tol));
+            }
+            escaped.fetch_add(out, Ordering::Relaxed);
+        });
         self.energy = world.kinetic_energy();
-        self.max_overlap_rel = scratch.max_overlap_rel(world, exec);
-        self.escaped = world.escaped();
+        // A model may know the overlap from its next step's detection.
+        self.max_overlap_rel = model
+            .and_then(|(m, dt)| m.max_overlap_rel(world, dt, exec))
+            .unwrap_or_else(|| scratch.max_overlap_rel(world, exec));
+        self.escaped = escaped.into_inner();
         self.counters = world.counters;
     }
 

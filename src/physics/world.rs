@@ -55,9 +55,7 @@ impl World {
         let tol = 1e-9 * self.size;
         self.spheres
             .iter()
-            .filter(|s| {
-                (0..3).any(|k| s.pos[k] < s.radius - tol || s.pos[k] > self.size - s.radius + tol)
-            })
+            .filter(|s| escapes(s, self.size, tol))
             .count()
     }
 
@@ -80,4 +78,10 @@ impl World {
             .iter()
             .any(|s| !(s.pos.is_finite() && s.vel.is_finite()))
     }
+}
+
+/// Whether `s`'s centre lies outside `[r, size - r]` by more than `tol`.
+#[inline]
+pub fn escapes(s: &Sphere, size: f64, tol: f64) -> bool {
+    (0..3).any(|k| s.pos[k] < s.radius - tol || s.pos[k] > size - s.radius + tol)
 }

@@ -38,7 +38,21 @@ pub struct Swept {
     sorted: Vec<Mutex<(Vec<Pair>, Vec<Pair>)>>,
     meets: Vec<Pair>,
     near: Vec<Pair>,
+    /// Per block of candidate pairs: the deepest overlap among them.
+    overlap: Vec<Mutex<f64>>,
     rounds: Rounds,
+    /// Detection already made for the next step of the world it names.
+    ahead: Option<Ahead>,
+}
+
+/// A detection made ahead of its step (when the engine asked for the
+/// overlap of the world a frame ended with): valid for the world with this
+/// fingerprint and this `dt` only.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Ahead {
+    dt: f64,
+    print: u64,
+    overlap: f64,
 }
 
 /// The ball a sphere on a straight path stays in during the step: centred
@@ -64,6 +78,27 @@ impl Model for Swept {
             world.time += dt;
         }
     }
+
+    fn invalidate(&mut self) {
+        self.ahead = None;
+    }
+
+    /// The next step's detection finds every pair whose balls meet, and a
+    /// sphere's ball holds the sphere: the overlapping pairs are among them.
+    /// So the overlap costs nothing extra, and the next step reuses the
+    /// detection if the world is still the same.
+    fn max_overlap_rel(&mut self, world: &World, dt: f64, exec: &dyn Exec) -> Option<f64> {
+        let print = fingerprint(&world.spheres, exec);
+        if let Some(a) = self.ahead
+            && a.dt == dt
+            && a.print == print
+        {
+            return Some(a.overlap);
+        }
+        let overlap = self.detect(world, dt, exec);
+        self.ahead = Some(Ahead { dt, print, overlap });
+        Some(overlap)
+    }
 }
 
 impl Swept {
@@ -81,13 +116,13 @@ impl Swept {
 
     fn step(&mut self, world: &mut World, dt: f64, exec: &dyn Exec) {
         let size = world.size;
-        let sp = &world.spheres;
-        self.detect
-            .run(exec, sp, size, |s| path_ball(s, dt), &|_, _| true, &|s| {
-                reaches_wall(s, size, dt)
-            });
-        self.detect.wall_hits(&mut self.hits);
-        self.sort_pairs(sp, dt, exec);
+        let ready = self
+            .ahead
+            .take()
+            .is_some_and(|a| a.dt == dt && a.print == fingerprint(&world.spheres, exec));
+        if !ready {
+            self.detect(world, dt, exec);
+        }
         self.rounds.run(
             exec,
             &mut world.spheres,
@@ -110,31 +145,54 @@ impl Swept {
         });
     }
 
+    /// Finds the pairs and walls of a step of `dt` from `world`; returns the
+    /// deepest overlap among the pairs (relative to the smaller radius).
+    fn detect(&mut self, world: &World, dt: f64, exec: &dyn Exec) -> f64 {
+        let size = world.size;
+        let sp = &world.spheres;
+        self.detect
+            .run(exec, sp, size, |s| path_ball(s, dt), &|_, _| true, &|s| {
+                reaches_wall(s, size, dt)
+            });
+        self.detect.wall_hits(&mut self.hits);
+        self.sort_pairs(sp, dt, exec)
+    }
+
     /// Splits the pairs whose balls overlap into those whose straight paths
-    /// meet within the step and the rest, keeping their order.
-    fn sort_pairs(&mut self, sp: &[Sphere], dt: f64, exec: &dyn Exec) {
+    /// meet within the step and the rest, keeping their order; returns the
+    /// deepest overlap among them.
+    fn sort_pairs(&mut self, sp: &[Sphere], dt: f64, exec: &dyn Exec) -> f64 {
         let pairs = &self.detect.pairs;
         let blocks = pairs.len().div_ceil(PAIR_BLOCK);
         while self.sorted.len() < blocks {
             self.sorted.push(Mutex::new(Default::default()));
+            self.overlap.push(Mutex::new(0.0));
         }
-        let sorted = &self.sorted;
+        let (sorted, overlap) = (&self.sorted, &self.overlap);
         for_each_block(exec, blocks, &|b| {
             let mut guard = sorted[b].lock();
             let (meets, near) = &mut *guard;
             meets.clear();
             near.clear();
+            let mut deepest: f64 = 0.0;
             let end = ((b + 1) * PAIR_BLOCK).min(pairs.len());
             for &(i, j) in &pairs[b * PAIR_BLOCK..end] {
                 let (a, c) = (&sp[i as usize], &sp[j as usize]);
-                if pair_toi(a.pos - c.pos, a.vel - c.vel, a.radius + c.radius)
-                    .is_some_and(|t| t <= dt)
-                {
+                let (dp, sigma) = (a.pos - c.pos, a.radius + c.radius);
+                // The same depth `World::max_overlap_rel` computes, to the bit.
+                if dp.length_squared() <= sigma * sigma * (1.0 + 1e-9) {
+                    let depth = sigma - a.pos.distance(c.pos);
+                    if depth > 0.0 {
+                        deepest = deepest.max(depth / a.radius.min(c.radius));
+                    }
+                }
+                if pair_toi(dp, a.vel - c.vel, sigma).is_some_and(|t| t <= dt) {
                     meets.push((i, j));
                 } else {
                     near.push((i, j));
                 }
             }
+            *overlap[b].lock() = deepest;
         });
         self.meets.clear();
         self.near.clear();
@@ -143,7 +201,37 @@ impl Swept {
             self.meets.extend_from_slice(&guard.0);
             self.near.extend_from_slice(&guard.1);
         }
+        self.overlap[..blocks]
+            .iter()
+            .fold(0.0, |worst, d| worst.max(*d.lock()))
     }
+}
+
+/// Spheres per parallel block of the fingerprint.
+const PRINT_BLOCK: usize = 8192;
+
+/// A hash of every position, velocity and radius: tells whether the world
+/// a detection was made for is still the one about to step.
+fn fingerprint(spheres: &[Sphere], exec: &dyn Exec) -> u64 {
+    let blocks = spheres.len().div_ceil(PRINT_BLOCK);
+    let prints: Vec<Mutex<u64>> = (0..blocks).map(|_| Mutex::new(0)).collect();
+    for_each_block(exec, blocks, &|b| {
+        let end = ((b + 1) * PRINT_BLOCK).min(spheres.len());
+        let mut h = 0x9e37_79b9_7f4a_7c15u64 ^ b as u64;
+        for s in &spheres[b * PRINT_BLOCK..end] {
+            for x in [
+                s.pos.x, s.pos.y, s.pos.z, s.vel.x, s.vel.y, s.vel.z, s.radius,
+            ] {
+                h = (h ^ x.to_bits())
+                    .wrapping_mul(0x0100_0000_01b3)
+                    .rotate_left(23);
+            }
+        }
+        *prints[b].lock() = h;
+    });
+    prints.iter().fold(spheres.len() as u64, |h, p| {
+        (h ^ *p.lock()).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+    })
 }
 
 /// Whether the straight path of `s` over `dt` leaves `[r, L - r]^3` (the
