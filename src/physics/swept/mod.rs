@@ -88,7 +88,7 @@ impl Model for Swept {
     /// So the overlap costs nothing extra, and the next step reuses the
     /// detection if the world is still the same.
     fn max_overlap_rel(&mut self, world: &World, dt: f64, exec: &dyn Exec) -> Option<f64> {
-        let print = fingerprint(&world.spheres, exec);
+        let print = fingerprint(world);
         if let Some(a) = self.ahead
             && a.dt == dt
             && a.print == print
@@ -119,7 +119,7 @@ impl Swept {
         let ready = self
             .ahead
             .take()
-            .is_some_and(|a| a.dt == dt && a.print == fingerprint(&world.spheres, exec));
+            .is_some_and(|a| a.dt == dt && a.print == fingerprint(world));
         if !ready {
             self.detect(world, dt, exec);
         }
@@ -207,31 +207,27 @@ impl Swept {
     }
 }
 
-/// Spheres per parallel block of the fingerprint.
-const PRINT_BLOCK: usize = 8192;
+/// Spheres the fingerprint samples.
+const PRINT_SAMPLES: usize = 64;
 
-/// A hash of every position, velocity and radius: tells whether the world
-/// a detection was made for is still the one about to step.
-fn fingerprint(spheres: &[Sphere], exec: &dyn Exec) -> u64 {
-    let blocks = spheres.len().div_ceil(PRINT_BLOCK);
-    let prints: Vec<Mutex<u64>> = (0..blocks).map(|_| Mutex::new(0)).collect();
-    for_each_block(exec, blocks, &|b| {
-        let end = ((b + 1) * PRINT_BLOCK).min(spheres.len());
-        let mut h = 0x9e37_79b9_7f4a_7c15u64 ^ b as u64;
-        for s in &spheres[b * PRINT_BLOCK..end] {
-            for x in [
-                s.pos.x, s.pos.y, s.pos.z, s.vel.x, s.vel.y, s.vel.z, s.radius,
-            ] {
-                h = (h ^ x.to_bits())
-                    .wrapping_mul(0x0100_0000_01b3)
-                    .rotate_left(23);
-            }
+/// A cheap mark of the world a detection was made for: its time, its count
+/// and a spread sample of spheres. Changes from outside must be announced
+/// with `Model::invalidate` (the engine does); this only catches a caller
+/// who hands a different world without doing so.
+fn fingerprint(world: &World) -> u64 {
+    let n = world.spheres.len();
+    let mut h = (n as u64) ^ world.time.to_bits().rotate_left(17) ^ world.size.to_bits();
+    for k in 0..PRINT_SAMPLES.min(n) {
+        let s = &world.spheres[k * n / PRINT_SAMPLES.min(n)];
+        for x in [
+            s.pos.x, s.pos.y, s.pos.z, s.vel.x, s.vel.y, s.vel.z, s.radius,
+        ] {
+            h = (h ^ x.to_bits())
+                .wrapping_mul(0x0100_0000_01b3)
+                .rotate_left(23);
         }
-        *prints[b].lock() = h;
-    });
-    prints.iter().fold(spheres.len() as u64, |h, p| {
-        (h ^ *p.lock()).wrapping_mul(0x9e37_79b9_7f4a_7c15)
-    })
+    }
+    h
 }
 
 /// Whether the straight path of `s` over `dt` leaves `[r, L - r]^3` (the
