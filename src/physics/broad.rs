@@ -502,6 +502,18 @@ impl Grid {
         }
     }
 
+    /// Every sphere whose ball, as binned, may meet a ball of radius `reach`
+    /// around `p`, as `f(id, centre, reach)`: like [`Grid::near`] for
+    /// callers that track grown balls themselves, so a narrower search.
+    pub fn near_binned(&self, p: DVec3, reach: f64, f: &mut impl FnMut(u32, DVec3, f64)) {
+        for level in &self.levels {
+            level.near(p, reach + level.reach_max, &mut |b| f(b.id, b.pos, b.reach));
+        }
+        for b in &self.top {
+            f(b.id, b.pos, b.reach);
+        }
+    }
+
     /// How far a sphere that started with reach `reach` may grow and still
     /// be found by [`Grid::near`]; beyond it the caller must track it itself.
     pub fn growth_cap(&self, reach: f64) -> f64 {

@@ -14,6 +14,11 @@ use glam::DVec3;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
+/// Runs with at most this many members check each other one by one on a
+/// rescan; bigger ones (and the absorbing run) find members through the
+/// grid.
+const SMALL_RUN: usize = 32;
+
 /// What every run of a step reads: the state at the start of the step and
 /// who has events.
 pub(super) struct Shared<'a> {
@@ -277,10 +282,31 @@ impl Run {
         }
         let ca = self.count[la];
         push_wall(&mut self.heap, &sa, ia, la as u32, t, ca, sh.size, sh.dt);
-        let (p0, ra) = (self.centre[la], self.reach[la]);
         let mut found = std::mem::take(&mut self.found);
         found.clear();
-        {
+        if !absorb && self.ids.len() <= SMALL_RUN {
+            // Only what is left of the path can meet anyone, and members
+            // are few: they are checked one by one with their grown balls,
+            // so the grid is searched only for balls as binned.
+            let rem = 0.5 * (sh.dt - t);
+            let (q, rq) = (
+                sa.pos + sa.vel * rem,
+                (sa.radius + sa.vel.length() * rem) * REACH_SLACK,
+            );
+            let this = &*self;
+            sh.grid.near_binned(q, rq, &mut |j, pj0, rj| {
+                if this.member(j).is_none() && q.distance_squared(pj0) <= (rq + rj) * (rq + rj) {
+                    found.push(j);
+                }
+            });
+            for l in 0..this.ids.len() {
+                let r = rq + this.reach[l];
+                if l != la && q.distance_squared(this.centre[l]) <= r * r {
+                    found.push(this.ids[l]);
+                }
+            }
+        } else {
+            let (p0, ra) = (self.centre[la], self.reach[la]);
             let this = &*self;
             // Outsiders are judged by the ball the grid holds for them: a
             // run never reads another run's state.
