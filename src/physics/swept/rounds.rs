@@ -8,8 +8,9 @@
 //! into each other. Those are merged (an outsider with no event joins) and
 //! run again, until a round ends with no conflict. After a few parallel
 //! rounds the rest run as one cluster that takes outsiders in as it meets
-//! them, which is the plain serial event loop; on one lane that is all
-//! there is.
+//! them, which is the plain serial event loop. One lane runs clusters too:
+//! small event queues and rescans that check a few members directly cost
+//! less than one queue for the whole step.
 //!
 //! The result is the serial loop's, bit for bit, however the clusters fall
 //! and whatever runs them: clusters that cannot touch each other have no
@@ -120,7 +121,7 @@ impl Rounds {
         hits: &[u32],
         counters: &mut Counters,
     ) {
-        let serial = self.serial_only || exec.lanes() < 2;
+        let serial = self.serial_only;
         self.start(spheres.len(), meets, near, hits, serial);
         let mut round = 0;
         loop {
