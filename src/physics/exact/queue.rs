@@ -19,12 +19,15 @@ impl Node {
         t: f64::INFINITY,
         id: u32::MAX,
     };
+}
 
-    /// Earlier time first; on a tie, the lower sphere index.
-    #[inline(always)]
-    fn before(self, o: Node) -> bool {
-        self.t < o.t || (self.t == o.t && self.id < o.id)
-    }
+/// Whether the right child of a pair beats the left. Ties go left, and the
+/// left subtree holds the lower indices, so every inner node holds the
+/// earliest event of its subtree, the lowest index among equal times,
+/// without comparing indices.
+#[inline(always)]
+fn right_wins(l: Node, r: Node) -> bool {
+    r.t < l.t
 }
 
 #[derive(Clone, Debug, Default)]
@@ -51,25 +54,24 @@ impl EventQueue {
     pub fn rebuild(&mut self) {
         for k in (1..self.size).rev() {
             let (l, r) = (self.nodes[2 * k], self.nodes[2 * k + 1]);
-            self.nodes[k] = if r.before(l) { r } else { l };
+            self.nodes[k] = if right_wins(l, r) { r } else { l };
         }
     }
 
-    /// Sphere `i`'s pending event is now at `t`.
+    /// Sphere `i`'s pending event is now at `t`. Climbs to the root always,
+    /// and picks each winner by index arithmetic: stopping early where the
+    /// winner stays saves little, and a branch on either the stop or the
+    /// comparison is taken at random (LLVM turns a plain select back into
+    /// such a branch).
     #[inline]
     pub fn update(&mut self, i: usize, t: f64) {
         let mut k = self.size + i;
         self.nodes[k] = Node { t, id: i as u32 };
         while k > 1 {
-            let l = self.nodes[k & !1];
-            let r = self.nodes[k | 1];
+            let left = k & !1;
+            let pick = left + right_wins(self.nodes[left], self.nodes[left | 1]) as usize;
             k >>= 1;
-            let win = if r.before(l) { r } else { l };
-            if self.nodes[k] == win {
-                // Nothing above changes: the same winner was already there.
-                break;
-            }
-            self.nodes[k] = win;
+            self.nodes[k] = self.nodes[pick];
         }
     }
 
@@ -133,5 +135,34 @@ mod tests {
         assert_eq!(q.time_of(0), 10.0);
         q.shift(0.5);
         assert_eq!(q.peek(), (0.0, 2));
+    }
+
+    /// Random updates with many equal times (and infinities), against a
+    /// scan of all leaves: earliest time, then lowest index.
+    #[test]
+    fn peek_matches_a_scan_with_ties() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(3);
+        for n in [1, 2, 3, 5, 64, 100] {
+            let mut q = EventQueue::default();
+            q.reset(n);
+            let mut times = vec![f64::INFINITY; n];
+            q.rebuild();
+            for _ in 0..5000 {
+                let i = rng.random_range(0..n);
+                let t = match rng.random_range(0..10) {
+                    0 => f64::INFINITY,
+                    k => (k % 4) as f64,
+                };
+                times[i] = t;
+                q.update(i, t);
+                let best = times.iter().copied().fold(f64::INFINITY, f64::min);
+                let (t, id) = q.peek();
+                assert_eq!(t, best);
+                if best.is_finite() {
+                    assert_eq!(id, times.iter().position(|&x| x == best).unwrap());
+                }
+            }
+        }
     }
 }
