@@ -13,7 +13,7 @@ pub const BLOCK: usize = 3;
 
 #[derive(Clone, Debug, Default)]
 pub struct CellSlots {
-    /// Per cell: the count, then the first `BLOCK` spheres.
+    /// Per cell: the first `BLOCK` spheres, then the count.
     blocks: Vec<[u32; BLOCK + 1]>,
     /// Per cell: spheres `BLOCK..count` (empty almost always).
     overflow: Vec<Vec<u32>>,
@@ -39,7 +39,7 @@ impl CellSlots {
 
     fn set(&mut self, c: usize, k: usize, j: u32) {
         if k < BLOCK {
-            self.blocks[c][1 + k] = j;
+            self.blocks[c][k] = j;
         } else {
             let o = &mut self.overflow[c];
             if k - BLOCK == o.len() {
@@ -53,23 +53,23 @@ impl CellSlots {
 
     fn get(&self, c: usize, k: usize) -> u32 {
         if k < BLOCK {
-            self.blocks[c][1 + k]
+            self.blocks[c][k]
         } else {
             self.overflow[c][k - BLOCK]
         }
     }
 
     pub fn insert(&mut self, i: usize, c: usize) {
-        let k = self.blocks[c][0] as usize;
+        let k = self.blocks[c][BLOCK] as usize;
         self.set(c, k, i as u32);
-        self.blocks[c][0] += 1;
+        self.blocks[c][BLOCK] += 1;
     }
 
     /// Take sphere `i` out of its cell; the cell's last sphere fills its place.
     pub fn remove(&mut self, i: usize) {
         let (c, k) = self.at[i];
         let (c, k) = (c as usize, k as usize);
-        let last = self.blocks[c][0] as usize - 1;
+        let last = self.blocks[c][BLOCK] as usize - 1;
         if k != last {
             let moved = self.get(c, last);
             self.set(c, k, moved);
@@ -77,7 +77,7 @@ impl CellSlots {
         if last >= BLOCK {
             self.overflow[c].pop();
         }
-        self.blocks[c][0] -= 1;
+        self.blocks[c][BLOCK] -= 1;
         self.at[i] = (NONE, NONE);
     }
 
@@ -87,29 +87,32 @@ impl CellSlots {
         self.insert(i, c);
     }
 
-    /// Collect the spheres of `cells` into `out[..n]` and return `n`
-    /// (`out` is scratch: its length past `n` means nothing). Order: cell by
-    /// cell, each in its stored order.
-    #[inline]
-    pub fn gather(&self, cells: &[usize], out: &mut Vec<u32>) -> usize {
-        // Room for a whole block per remaining cell, so the copy below is
-        // unconditional.
-        if out.len() < cells.len() * BLOCK {
-            out.resize(cells.len() * BLOCK, 0);
+    /// Collect the spheres of the cells `base + offsets[..]` into `out[..n]`
+    /// and return `n` (`out` is scratch: its length past `n` means nothing).
+    /// Order: each cell's block in turn, then any overflow in the same order.
+    #[inline(always)]
+    pub fn gather(&self, base: usize, offsets: &[usize], out: &mut Vec<u32>) -> usize {
+        // Room to copy a whole block for every cell, so each copy is
+        // unconditional: one 16-byte move, the count landing past the end.
+        let room = offsets.len() * BLOCK + 1;
+        if out.len() < room {
+            out.resize(room, 0);
         }
         let mut n = 0;
-        for (done, &c) in cells.iter().enumerate() {
-            let b = &self.blocks[c];
-            out[n..n + BLOCK].copy_from_slice(&b[1..]);
-            let k = b[0] as usize;
-            if k <= BLOCK {
-                n += k;
-            } else {
-                out.truncate(n + BLOCK);
-                out.extend_from_slice(&self.overflow[c]);
-                n = out.len();
-                out.resize(n + (cells.len() - done - 1) * BLOCK, 0);
+        let mut spilled = false;
+        for &o in offsets {
+            let b = &self.blocks[base + o];
+            out[n..n + BLOCK + 1].copy_from_slice(b);
+            let k = b[BLOCK] as usize;
+            n += k.min(BLOCK);
+            spilled |= k > BLOCK;
+        }
+        if spilled {
+            out.truncate(n);
+            for &o in offsets {
+                out.extend_from_slice(&self.overflow[base + o]);
             }
+            n = out.len();
         }
         n
     }
@@ -147,7 +150,7 @@ mod tests {
                 reference[to].push(i as u32);
             }
             for (c, want) in reference.iter().enumerate() {
-                let n = s.gather(&[c], &mut out);
+                let n = s.gather(c, &[0], &mut out);
                 let mut got = out[..n].to_vec();
                 got.sort_unstable();
                 let mut want = want.clone();
@@ -157,7 +160,7 @@ mod tests {
                     assert_eq!(s.cell(j as usize), c as u32);
                 }
             }
-            let all = s.gather(&(0..cells).collect::<Vec<_>>(), &mut out);
+            let all = s.gather(0, &(0..cells).collect::<Vec<_>>(), &mut out);
             assert_eq!(all, reference.iter().map(Vec::len).sum::<usize>());
         }
         assert!(reference.iter().any(|l| l.len() > BLOCK));

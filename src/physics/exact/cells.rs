@@ -197,10 +197,10 @@ impl Cells {
                         .flat_map(move |y| (lo[0]..=hi[0]).map(move |x| self.index([x, y, z])))
                 })
                 .collect();
-            self.list.gather(&cells, out)
+            self.list.gather(0, &cells, out)
         } else {
             let corner = self.list.cell(i) as usize - self.stencil[13];
-            self.list.gather(&self.stencil.map(|o| corner + o), out)
+            self.list.gather(corner, &self.stencil, out)
         };
         if self.bigs.is_empty() {
             return n;
@@ -218,8 +218,7 @@ impl Cells {
     #[inline]
     pub fn new_candidates(&self, i: usize, mask: u8, out: &mut Vec<u32>) -> usize {
         let corner = self.list.cell(i) as usize - self.stencil[13];
-        self.list
-            .gather(&self.layers[mask as usize].map(|o| corner + o), out)
+        self.list.gather(corner, &self.layers[mask as usize], out)
     }
 
     fn coords(&self, p: DVec3) -> [usize; 3] {
