@@ -137,22 +137,19 @@ impl Cells {
         let last = self.per_side as u32 - 1;
         let mut best = f64::INFINITY;
         let mut mask = 0u8;
-        // Selects rather than branches: the signs of the velocity are random,
-        // so branching on them mispredicts half the time.
+        // No branches on the signs of the velocity: they are random, so a
+        // branch on them mispredicts half the time (and LLVM turns plain
+        // selects back into such branches; indexing does not).
         for (k, &ck) in coord.iter().enumerate() {
             let v = b.vel[k];
             let up = v > 0.0;
-            let face = if up { ck + 1 } else { ck };
+            let face = ck + up as u32;
             let t = ((face as f64 * self.cell - b.pos[k]) / v).max(0.0);
-            let open = if up { ck < last } else { v < 0.0 && ck > 0 };
-            let t = if open { t } else { f64::INFINITY };
+            let open = (ck != [0, last][up as usize]) & (v != 0.0);
+            let t = [f64::INFINITY, t][open as usize];
             let better = t < best;
-            best = if better { t } else { best };
-            mask = if better {
-                k as u8 | (up as u8) << 2
-            } else {
-                mask
-            };
+            best = [best, t][better as usize];
+            mask = [mask, k as u8 | (up as u8) << 2][better as usize];
         }
         let ev = Event {
             kind: Kind::Cross,
