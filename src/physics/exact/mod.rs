@@ -313,7 +313,7 @@ impl Exact {
             unreachable!("crossings only in cell mode")
         };
         let a = &self.bodies[i];
-        let mut p = Predictor::new(a, &self.bodies, &self.counts, self.size, tp - a.t, evp);
+        let mut p = Predictor::resume(a, &self.bodies, &self.counts, tp - a.t, evp);
         let n = cells.new_candidates(i, mask, &mut self.candidates);
         for &j in &self.candidates[..n] {
             p.pair(j);

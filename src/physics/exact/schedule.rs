@@ -77,6 +77,19 @@ impl<'a> Predictor<'a> {
         p
     }
 
+    /// Continue from an earlier prediction's best `(t, ev)` (relative time),
+    /// which already weighed the walls: sphere `a` has not turned since.
+    #[inline]
+    pub fn resume(a: &Body, bodies: &'a [Body], counts: &'a [u32], t: f64, ev: Event) -> Self {
+        Predictor {
+            a: *a,
+            bodies,
+            counts,
+            best: t,
+            ev,
+        }
+    }
+
     /// Consider a contact with sphere `j`.
     #[inline(always)]
     pub fn pair(&mut self, j: u32) {
