@@ -3,8 +3,8 @@
 //! bulk diameter, so spheres can only touch from neighbouring cells; a
 //! sphere's candidates are the spheres in the 27 cells around its own. A
 //! sphere changes cell only at a crossing event, so the pair bookkeeping is
-//! one linked-list move, and crossings are rarer than neighbour-list
-//! rebuilds when the mean free path is long.
+//! one move between cells ([`CellSlots`]), and crossings are rarer than
+//! neighbour-list rebuilds when the mean free path is long.
 //!
 //! Large spheres (the few far above the bulk radius) stay out of the grid:
 //! every small sphere checks them at each prediction, and a large one scans
