@@ -26,7 +26,8 @@ pub struct Cells {
     /// so the stencils below need no bounds checks (an unpredictable branch
     /// per cell otherwise).
     padded: usize,
-    /// Offsets from a cell's (-1, -1, -1) neighbour to its 27 neighbours,
+    /// Offsets from a cell's (-1, -1, -1) neighbour to its 27 neighbours
+    /// (itself first),
     /// and to the 9 of the layer a crossing brings next to it (one set per
     /// direction, indexed by the crossing's mask).
     stencil: [usize; 27],
@@ -87,14 +88,15 @@ impl Cells {
         self.padded = self.per_side + 2;
         let q = self.padded;
         let at = |x: usize, y: usize, z: usize| x + q * (y + q * z);
-        let mut k = 0;
-        for z in 0..3 {
-            for y in 0..3 {
-                for x in 0..3 {
-                    self.stencil[k] = at(x, y, z);
-                    k += 1;
-                }
-            }
+        let cube = (0..27).map(|k| [k % 3, k / 3 % 3, k / 9]);
+        // Own cell first, then faces, edges, corners: near partners come
+        // first, so the running best is small early and fewer of the later
+        // candidates pass the cheap test (each pass costs a root and, being
+        // random, often a mispredicted branch).
+        let mut near: Vec<[usize; 3]> = cube.clone().collect();
+        near.sort_by_key(|c| c.iter().filter(|&&x| x != 1).count());
+        for (slot, c) in self.stencil.iter_mut().zip(near) {
+            *slot = at(c[0], c[1], c[2]);
         }
         for mask in 0..8u8 {
             let axis = (mask & 3) as usize;
@@ -102,12 +104,9 @@ impl Cells {
                 continue;
             }
             let side = if mask & 4 != 0 { 2 } else { 0 };
-            let layer = self.stencil.iter().enumerate().filter(|&(k, _)| {
-                let c = [k % 3, k / 3 % 3, k / 9];
-                c[axis] == side
-            });
-            for (slot, (_, &off)) in self.layers[mask as usize].iter_mut().zip(layer) {
-                *slot = off;
+            let layer = cube.clone().filter(|c| c[axis] == side);
+            for (slot, c) in self.layers[mask as usize].iter_mut().zip(layer) {
+                *slot = at(c[0], c[1], c[2]);
             }
         }
     }
@@ -196,7 +195,7 @@ impl Cells {
                 .collect();
             self.list.gather(0, &cells, out)
         } else {
-            let corner = self.list.cell(i) as usize - self.stencil[13];
+            let corner = self.list.cell(i) as usize - self.stencil[0];
             self.list.gather(corner, &self.stencil, out)
         };
         if self.bigs.is_empty() {
@@ -214,7 +213,7 @@ impl Cells {
     /// all it could touch (Rapaport's trick: a crossing scans 9 cells, not 27).
     #[inline]
     pub fn new_candidates(&self, i: usize, mask: u8, out: &mut Vec<u32>) -> usize {
-        let corner = self.list.cell(i) as usize - self.stencil[13];
+        let corner = self.list.cell(i) as usize - self.stencil[0];
         self.list.gather(corner, &self.layers[mask as usize], out)
     }
 
