@@ -1,6 +1,9 @@
-//! What both broad phases of `exact` share: the spheres of each grid cell
-//! as intrusive doubly linked lists (a sphere moves between cells in O(1)),
-//! and the split of the few large spheres off to a second level.
+//! What both broad phases of `exact` share: the split of the few large
+//! spheres off to a second level, and the exit time from a ball; and the
+//! neighbour lists' grid: the spheres of each cell as intrusive doubly
+//! linked lists (a sphere moves between cells in O(1); the cell-crossing
+//! broad phase, which gathers cells far more often, keeps them in
+//! [`CellSlots`](super::cell_slots::CellSlots) instead).
 use super::body::Body;
 use glam::DVec3;
 

@@ -3,8 +3,8 @@
 //! bulk diameter, so spheres can only touch from neighbouring cells; a
 //! sphere's candidates are the spheres in the 27 cells around its own. A
 //! sphere changes cell only at a crossing event, so the pair bookkeeping is
-//! one linked-list move, and crossings are rarer than neighbour-list
-//! rebuilds when the mean free path is long.
+//! one move between cells ([`CellSlots`]), and crossings are rarer than
+//! neighbour-list rebuilds when the mean free path is long.
 //!
 //! Large spheres (the few far above the bulk radius) stay out of the grid:
 //! every small sphere checks them at each prediction, and a large one scans
@@ -12,7 +12,8 @@
 //! the skin (a small sphere entering that reach does so by a crossing, which
 //! checks the large ones).
 use super::body::Body;
-use super::cell_list::{CellList, NONE, split_big, time_to_leave};
+use super::cell_list::{NONE, split_big, time_to_leave};
+use super::cell_slots::CellSlots;
 use super::schedule::{Event, Kind};
 use glam::DVec3;
 
@@ -21,9 +22,22 @@ const BIG_FACTOR: f64 = 3.0;
 #[derive(Clone, Debug, Default)]
 pub struct Cells {
     per_side: usize,
+    /// Cells per side with a layer of always-empty cells around the grid,
+    /// so the stencils below need no bounds checks (an unpredictable branch
+    /// per cell otherwise).
+    padded: usize,
+    /// Offsets from a cell's (-1, -1, -1) neighbour to its 27 neighbours
+    /// (itself first),
+    /// and to the 9 of the layer a crossing brings next to it (one set per
+    /// direction, indexed by the crossing's mask).
+    stencil: [usize; 27],
+    layers: [[usize; 9]; 8],
+    /// Each small sphere's cell coordinates (unpadded), kept so that events
+    /// need no integer division.
+    coord: Vec<[u32; 3]>,
     cell: f64,
     /// The small spheres of each cell; large ones are in no cell.
-    list: CellList,
+    list: CellSlots,
     bigs: Vec<u32>,
     /// Where each large sphere last scanned from (indexed like `bigs`).
     scan_centre: Vec<DVec3>,
@@ -53,7 +67,10 @@ impl Cells {
         self.per_side = (size / cell_min).floor().clamp(1.0, cap) as usize;
         self.cell = size / self.per_side as f64;
         self.skin = self.cell;
-        self.list.reset(n, self.per_side.pow(3));
+        self.set_stencils();
+        self.list.reset(n, self.padded.pow(3));
+        self.coord.clear();
+        self.coord.resize(n, [0; 3]);
         for (i, b) in bodies.iter().enumerate() {
             if b.radius > big_above {
                 self.big_slot[i] = self.bigs.len() as u32;
@@ -61,7 +78,35 @@ impl Cells {
                 self.scan_centre.push(b.pos);
             } else {
                 let c = self.coords(b.pos);
+                self.coord[i] = c.map(|x| x as u32);
                 self.list.insert(i, self.index(c));
+            }
+        }
+    }
+
+    fn set_stencils(&mut self) {
+        self.padded = self.per_side + 2;
+        let q = self.padded;
+        let at = |x: usize, y: usize, z: usize| x + q * (y + q * z);
+        let cube = (0..27).map(|k| [k % 3, k / 3 % 3, k / 9]);
+        // Own cell first, then faces, edges, corners: near partners come
+        // first, so the running best is small early and fewer of the later
+        // candidates pass the cheap test (each pass costs a root and, being
+        // random, often a mispredicted branch).
+        let mut near: Vec<[usize; 3]> = cube.clone().collect();
+        near.sort_by_key(|c| c.iter().filter(|&&x| x != 1).count());
+        for (slot, c) in self.stencil.iter_mut().zip(near) {
+            *slot = at(c[0], c[1], c[2]);
+        }
+        for mask in 0..8u8 {
+            let axis = (mask & 3) as usize;
+            if axis == 3 {
+                continue;
+            }
+            let side = if mask & 4 != 0 { 2 } else { 0 };
+            let layer = cube.clone().filter(|c| c[axis] == side);
+            for (slot, c) in self.layers[mask as usize].iter_mut().zip(layer) {
+                *slot = at(c[0], c[1], c[2]);
             }
         }
     }
@@ -87,25 +132,23 @@ impl Cells {
             };
             return (t, ev);
         }
-        let c = self.list.cell(i) as usize;
-        let p = self.per_side;
-        let coord = [c % p, (c / p) % p, c / (p * p)];
+        let coord = self.coord[i];
+        let last = self.per_side as u32 - 1;
         let mut best = f64::INFINITY;
         let mut mask = 0u8;
+        // No branches on the signs of the velocity: they are random, so a
+        // branch on them mispredicts half the time (and LLVM turns plain
+        // selects back into such branches; indexing does not).
         for (k, &ck) in coord.iter().enumerate() {
             let v = b.vel[k];
-            let t = if v > 0.0 && ck + 1 < p {
-                ((ck + 1) as f64 * self.cell - b.pos[k]) / v
-            } else if v < 0.0 && ck > 0 {
-                (ck as f64 * self.cell - b.pos[k]) / v
-            } else {
-                continue;
-            };
-            let t = t.max(0.0);
-            if t < best {
-                best = t;
-                mask = k as u8 | if v > 0.0 { 4 } else { 0 };
-            }
+            let up = v > 0.0;
+            let face = ck + up as u32;
+            let t = ((face as f64 * self.cell - b.pos[k]) / v).max(0.0);
+            let open = (ck != [0, last][up as usize]) & (v != 0.0);
+            let t = [f64::INFINITY, t][open as usize];
+            let better = t < best;
+            best = [best, t][better as usize];
+            mask = [mask, k as u8 | (up as u8) << 2][better as usize];
         }
         let ev = Event {
             kind: Kind::Cross,
@@ -118,14 +161,14 @@ impl Cells {
     /// Sphere `i` crosses into the next cell as `mask` says.
     #[inline]
     pub fn cross(&mut self, i: usize, mask: u8) {
-        let p = self.per_side;
-        let stride = [1, p, p * p][(mask & 3) as usize];
+        let q = self.padded;
+        let axis = (mask & 3) as usize;
+        let stride = [1, q, q * q][axis];
         let c = self.list.cell(i) as usize;
-        let to = if mask & 4 != 0 {
-            c + stride
-        } else {
-            c - stride
-        };
+        let up = mask & 4 != 0;
+        let to = if up { c + stride } else { c - stride };
+        let k = &mut self.coord[i][axis];
+        *k = if up { *k + 1 } else { *k - 1 };
         self.list.move_to(i, to);
     }
 
@@ -135,76 +178,43 @@ impl Cells {
     }
 
     /// Every sphere that sphere `i` could touch before its next broad-phase
-    /// event: the 27 cells around a small one, the cells over a large one's
+    /// event, into `out[..n]` (returns `n`; sphere `i` itself may be among
+    /// them): the 27 cells around a small one, the cells over a large one's
     /// reach from its scan centre; and every large sphere.
     #[inline]
-    pub fn for_each_candidate(&self, i: usize, b: &Body, mut f: impl FnMut(u32)) {
-        let p = self.per_side;
-        let (lo, hi) = if self.is_big(i) {
+    pub fn candidates(&self, i: usize, b: &Body, out: &mut Vec<u32>) -> usize {
+        let n = if self.is_big(i) {
             let centre = self.scan_centre[self.big_slot[i] as usize];
             let reach = DVec3::splat((b.radius + self.small_rmax + self.skin) * (1.0 + 1e-9));
-            (self.coords(centre - reach), self.coords(centre + reach))
+            let (lo, hi) = (self.coords(centre - reach), self.coords(centre + reach));
+            let cells: Vec<usize> = (lo[2]..=hi[2])
+                .flat_map(|z| {
+                    (lo[1]..=hi[1])
+                        .flat_map(move |y| (lo[0]..=hi[0]).map(move |x| self.index([x, y, z])))
+                })
+                .collect();
+            self.list.gather(0, &cells, out)
         } else {
-            let c = self.list.cell(i) as usize;
-            let coord = [c % p, (c / p) % p, c / (p * p)];
-            let m = p - 1;
-            (
-                coord.map(|x| x.saturating_sub(1)),
-                coord.map(|x| (x + 1).min(m)),
-            )
+            let corner = self.list.cell(i) as usize - self.stencil[0];
+            self.list.gather(corner, &self.stencil, out)
         };
-        for z in lo[2]..=hi[2] {
-            for y in lo[1]..=hi[1] {
-                let row = p * (y + p * z);
-                for x in lo[0]..=hi[0] {
-                    self.list.for_each_in(row + x, |j| {
-                        if j as usize != i {
-                            f(j);
-                        }
-                    });
-                }
-            }
+        if self.bigs.is_empty() {
+            return n;
         }
-        for &j in &self.bigs {
-            if j as usize != i {
-                f(j);
-            }
-        }
+        out.truncate(n);
+        out.extend_from_slice(&self.bigs);
+        out.len()
     }
 
     /// After a crossing (`mask` as in [`Kind::Cross`]): the spheres in the
-    /// layer of cells that just came next to sphere `i`'s new cell. Together
-    /// with its best event over the old neighbourhood, these are all it
-    /// could touch (Rapaport's trick: a crossing scans 9 cells, not 27).
+    /// layer of cells that just came next to sphere `i`'s new cell (empty
+    /// padding at the edge of the grid), into `out[..n]`; returns `n`.
+    /// Together with its best event over the old neighbourhood, these are
+    /// all it could touch (Rapaport's trick: a crossing scans 9 cells, not 27).
     #[inline]
-    pub fn for_each_new_candidate(&self, i: usize, mask: u8, mut f: impl FnMut(u32)) {
-        let p = self.per_side;
-        let c = self.list.cell(i) as usize;
-        let mut lo = [c % p, (c / p) % p, c / (p * p)];
-        let axis = (mask & 3) as usize;
-        let layer = if mask & 4 != 0 {
-            lo[axis] + 1
-        } else {
-            match lo[axis].checked_sub(1) {
-                Some(l) => l,
-                None => return,
-            }
-        };
-        if layer >= p {
-            return;
-        }
-        let mut hi = lo.map(|x| (x + 1).min(p - 1));
-        lo = lo.map(|x| x.saturating_sub(1));
-        lo[axis] = layer;
-        hi[axis] = layer;
-        for z in lo[2]..=hi[2] {
-            for y in lo[1]..=hi[1] {
-                let row = p * (y + p * z);
-                for x in lo[0]..=hi[0] {
-                    self.list.for_each_in(row + x, &mut f);
-                }
-            }
-        }
+    pub fn new_candidates(&self, i: usize, mask: u8, out: &mut Vec<u32>) -> usize {
+        let corner = self.list.cell(i) as usize - self.stencil[0];
+        self.list.gather(corner, &self.layers[mask as usize], out)
     }
 
     fn coords(&self, p: DVec3) -> [usize; 3] {
@@ -213,7 +223,9 @@ impl Cells {
         [c(p.x), c(p.y), c(p.z)]
     }
 
+    /// Index in the padded grid of the cell at unpadded coordinates `c`.
     fn index(&self, c: [usize; 3]) -> usize {
-        c[0] + self.per_side * (c[1] + self.per_side * c[2])
+        let q = self.padded;
+        (c[0] + 1) + q * ((c[1] + 1) + q * (c[2] + 1))
     }
 }

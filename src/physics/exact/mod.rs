@@ -38,6 +38,7 @@
 //! the schedule is rebuilt for the next step.
 pub mod body;
 pub mod cell_list;
+pub mod cell_slots;
 pub mod cells;
 pub mod lattice;
 pub mod neighbours;
@@ -75,13 +76,13 @@ pub const LISTS_ABOVE_PACKING: f64 = 0.3;
 /// each rebuild.
 #[derive(Clone, Debug)]
 enum Broad {
-    Lists(Neighbours),
-    Cells(Cells),
+    Lists(Box<Neighbours>),
+    Cells(Box<Cells>),
 }
 
 impl Default for Broad {
     fn default() -> Self {
-        Broad::Cells(Cells::default())
+        Broad::Cells(Box::default())
     }
 }
 
@@ -116,6 +117,8 @@ pub struct Exact {
     pending: Vec<(f64, Event)>,
     queue: EventQueue,
     broad: Broad,
+    /// Scratch for the candidates a prediction gathers.
+    candidates: Vec<u32>,
     size: f64,
     /// Absolute time of internal time zero.
     origin: f64,
@@ -218,11 +221,11 @@ impl Exact {
             .map(|b| crate::physics::sphere::volume(b.radius))
             .sum();
         if filled > LISTS_ABOVE_PACKING * self.size.powi(3) {
-            let mut nl = Neighbours::default();
+            let mut nl = Box::<Neighbours>::default();
             nl.build(&self.bodies, self.size);
             self.broad = Broad::Lists(nl);
         } else {
-            let mut cells = Cells::default();
+            let mut cells = Box::<Cells>::default();
             cells.build(&self.bodies, self.size);
             self.broad = Broad::Cells(cells);
         }
@@ -264,7 +267,12 @@ impl Exact {
                     f64::INFINITY,
                     idle,
                 );
-                cells.for_each_candidate(i, a, |j| p.pair(j));
+                let n = cells.candidates(i, a, &mut self.candidates);
+                for &j in &self.candidates[..n] {
+                    if j as usize != i {
+                        p.pair(j);
+                    }
+                }
                 self.pending[i] = p.finish();
                 self.with_crossing(i)
             }
@@ -305,8 +313,11 @@ impl Exact {
             unreachable!("crossings only in cell mode")
         };
         let a = &self.bodies[i];
-        let mut p = Predictor::new(a, &self.bodies, &self.counts, self.size, tp - a.t, evp);
-        cells.for_each_new_candidate(i, mask, |j| p.pair(j));
+        let mut p = Predictor::resume(a, &self.bodies, &self.counts, tp - a.t, evp);
+        let n = cells.new_candidates(i, mask, &mut self.candidates);
+        for &j in &self.candidates[..n] {
+            p.pair(j);
+        }
         self.pending[i] = p.finish();
         let (t, ev) = self.with_crossing(i);
         self.events[i] = ev;
