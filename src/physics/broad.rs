@@ -327,12 +327,28 @@ impl Level {
         let lo = cell_coords(p - DVec3::splat(span), self.inv_cell, last);
         let hi = cell_coords(p + DVec3::splat(span), self.inv_cell, last);
         let cs = &self.cell_start;
+        // As in `block_pairs`: rows hold a sphere or two, so four indices
+        // are copied from each unconditionally and the real ones counted,
+        // and `f` runs in one loop instead of one short loop per row.
+        let mut buf = [0u32; 64];
+        let mut len = 0;
         for z in lo[2]..=hi[2] {
             for y in lo[1]..=hi[1] {
                 let k = (lo[0] + 1) + self.side * ((y + 1) + self.side * (z + 1));
-                (cs[k] as usize..cs[k + hi[0] - lo[0] + 1] as usize).for_each(&mut *f);
+                let (from, to) = (cs[k], cs[k + hi[0] - lo[0] + 1]);
+                if len + 4 > buf.len() || to - from > 4 {
+                    buf[..len].iter().for_each(|&j| f(j as usize));
+                    len = 0;
+                    if to - from > 4 {
+                        (from as usize..to as usize).for_each(&mut *f);
+                        continue;
+                    }
+                }
+                buf[len..len + 4].copy_from_slice(&[from, from + 1, from + 2, from + 3]);
+                len += (to - from) as usize;
             }
         }
+        buf[..len].iter().for_each(|&j| f(j as usize));
     }
 }
 
