@@ -75,10 +75,12 @@ pub struct Grid {
 }
 
 /// Real cell coordinates of `p`, clamped into `0..=last`. Truncation is
-/// floor here (after max(0)), without a libm call.
+/// floor here (after max(0)), without a libm call; clamping in floating
+/// point first (NaN goes to 0) lets the cast be a 32-bit one.
 #[inline]
 fn cell_coords(p: DVec3, inv_cell: f64, last: usize) -> [usize; 3] {
-    let c = |x: f64| ((x * inv_cell).max(0.0) as usize).min(last);
+    let top = last as f64;
+    let c = |x: f64| (x * inv_cell).max(0.0).min(top) as u32 as usize;
     [c(p.x), c(p.y), c(p.z)]
 }
 
