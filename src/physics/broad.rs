@@ -43,6 +43,13 @@ pub type Pair = (u32, u32);
 /// side, so the neighbour cells of any real cell exist and need no bounds
 /// checks: the 13 forward neighbours of cell `c` are 5 contiguous key ranges
 /// at fixed offsets from `c`.
+/// A ball within reach of nothing (NaN compares false), padding the pair
+/// loops' candidate lists.
+const NOWHERE: Ball = Ball {
+    pos: DVec3::NAN,
+    reach: f64::NAN,
+};
+
 #[derive(Default)]
 struct Level {
     /// Real cells per side.
@@ -134,7 +141,9 @@ impl Level {
     }
 
     fn resize(&mut self, n: usize) {
+        self.balls.clear();
         self.balls.resize(n, Ball::default());
+        self.balls.push(NOWHERE);
         self.ids.resize(n, 0);
         self.keys.resize(n, 0);
     }
@@ -213,13 +222,18 @@ impl Level {
             self.reach_max = self.reach_max.max(reach_max);
         }
         offsets.push(sum);
+        self.balls.clear();
         self.balls.resize(sum as usize, Ball::default());
+        self.balls.push(NOWHERE);
         self.ids.resize(sum as usize, 0);
         self.keys.resize(sum as usize, 0);
         type Region<'a> = Mutex<(&'a mut [Ball], &'a mut [u32], &'a mut [u32])>;
         let mut regions: Vec<Region> = Vec::with_capacity(lanes);
-        let (mut balls, mut ids, mut keys) =
-            (&mut self.balls[..], &mut self.ids[..], &mut self.keys[..]);
+        let (mut balls, mut ids, mut keys) = (
+            &mut self.balls[..sum as usize],
+            &mut self.ids[..],
+            &mut self.keys[..],
+        );
         for l in 0..lanes {
             let len = (offsets[l + 1] - offsets[l]) as usize;
             let (b, more_b) = balls.split_at_mut(len);
@@ -267,6 +281,7 @@ impl Level {
         let keys = self.cell_start.len() - 1;
         let cs = &self.cell_start[..];
         let (balls, ids) = (&self.balls[..], &self.ids[..]);
+        let nowhere = (balls.len() - 1) as u32;
         let s = self.side;
         let mut k = cs[b * KEY_BLOCK] as usize;
         let hi = cs[((b + 1) * KEY_BLOCK).min(keys)] as usize;
@@ -287,9 +302,11 @@ impl Level {
                 let (a, ia) = (&balls[i], ids[i]);
                 // Nearly every window holds at most a few spheres, so copy
                 // four indices from each unconditionally and count only the
-                // real ones: one loop over the candidates instead of five
-                // short ones whose exits the branch predictor cannot guess.
-                let mut buf = [0u32; 4 * 5];
+                // real ones, then test the candidates four at a time, padded
+                // with `NOWHERE`: a loop that nearly always runs once, where
+                // five short loops had exits the branch predictor could not
+                // guess.
+                let mut buf = [nowhere; 4 * 6];
                 let mut len = 0;
                 let mut wide = false;
                 let mut gather = |lo: usize, hi: usize| {
@@ -303,15 +320,22 @@ impl Level {
                 gather(windows[1].0, windows[1].1);
                 gather(windows[2].0, windows[2].1);
                 gather(windows[3].0, windows[3].1);
+                buf[len..len + 4].copy_from_slice(&[nowhere; 4]);
                 if wide {
                     scan(a, ia, &balls[i + 1..row_end], &ids[i + 1..row_end], f);
                     for (lo, hi) in windows {
                         scan(a, ia, &balls[lo..hi], &ids[lo..hi], f);
                     }
                 } else {
-                    for &j in &buf[..len] {
-                        if within(a, &balls[j as usize]) {
-                            f(ia, ids[j as usize]);
+                    for four in buf[..len.next_multiple_of(4)].chunks_exact(4) {
+                        let near = |j: u32| within(a, &balls[j as usize]);
+                        // `|`, not `||`: all four tested without branches.
+                        if near(four[0]) | near(four[1]) | near(four[2]) | near(four[3]) {
+                            for &j in four {
+                                if near(j) {
+                                    f(ia, ids[j as usize]);
+                                }
+                            }
                         }
                     }
                 }
@@ -322,7 +346,7 @@ impl Level {
 
     /// Indices of the spheres in the cells covering `p ± span`.
     fn near(&self, p: DVec3, span: f64, f: &mut impl FnMut(usize)) {
-        if self.balls.is_empty() {
+        if self.ids.is_empty() {
             return;
         }
         let last = self.per_side - 1;
@@ -483,7 +507,7 @@ impl Grid {
         for (l, level) in self.levels.iter().enumerate() {
             units.extend((0..level.key_blocks()).map(|block| Unit::Block { level: l, block }));
             if l > 0 {
-                let n = level.balls.len();
+                let n = level.ids.len();
                 units.extend((0..n.div_ceil(CROSS_BLOCK)).map(|b| Unit::Cross {
                     level: l,
                     from: b * CROSS_BLOCK,
@@ -590,7 +614,7 @@ impl Grid {
         (
             self.levels
                 .iter()
-                .map(|l| (l.per_side, l.balls.len()))
+                .map(|l| (l.per_side, l.ids.len()))
                 .collect(),
             self.top.len(),
         )
