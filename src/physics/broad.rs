@@ -21,12 +21,18 @@ const CROSS_BLOCK: usize = 64;
 /// Spheres per parallel block while binning.
 const BUILD_BLOCK: usize = 4096;
 
+/// A sphere's ball for the step: it stays within `reach` of `pos`.
 #[derive(Clone, Copy, Debug, Default)]
-struct Entry {
+struct Ball {
     pos: DVec3,
     reach: f64,
-    id: u32,
-    /// Padded cell key (see `Level::side`).
+}
+
+/// A sphere on its way into the first level: its ball and padded cell key
+/// (`u32::MAX`: too wide for the level).
+#[derive(Clone, Copy, Debug, Default)]
+struct Staged {
+    ball: Ball,
     key: u32,
 }
 
@@ -37,6 +43,13 @@ pub type Pair = (u32, u32);
 /// side, so the neighbour cells of any real cell exist and need no bounds
 /// checks: the 13 forward neighbours of cell `c` are 5 contiguous key ranges
 /// at fixed offsets from `c`.
+/// A ball within reach of nothing (NaN compares false), padding the pair
+/// loops' candidate lists.
+const NOWHERE: Ball = Ball {
+    pos: DVec3::NAN,
+    reach: f64::NAN,
+};
+
 #[derive(Default)]
 struct Level {
     /// Real cells per side.
@@ -46,8 +59,12 @@ struct Level {
     inv_cell: f64,
     cell: f64,
     cell_start: Vec<u32>,
-    /// Spheres of this level, sorted by cell key.
-    entries: Vec<Entry>,
+    /// The spheres of this level sorted by cell key, as three parallel
+    /// arrays: the pair loops read the balls of every candidate but the id
+    /// only of the few within reach.
+    balls: Vec<Ball>,
+    ids: Vec<u32>,
+    keys: Vec<u32>,
     /// Largest reach in this level.
     reach_max: f64,
 }
@@ -56,20 +73,21 @@ struct Level {
 pub struct Grid {
     levels: Vec<Level>,
     /// The last few, tested against everything.
-    top: Vec<Entry>,
-    balls: Vec<(DVec3, f64)>,
-    keys: Vec<u32>,
+    top: Vec<(Ball, u32)>,
+    staged: Vec<Staged>,
     /// Spheres not yet placed in a level: (ball, id).
-    rest: Vec<(DVec3, f64, u32)>,
+    rest: Vec<(Ball, u32)>,
     scratch: Vec<f64>,
     slots: Vec<Mutex<Vec<Pair>>>,
 }
 
 /// Real cell coordinates of `p`, clamped into `0..=last`. Truncation is
-/// floor here (after max(0)), without a libm call.
+/// floor here (after max(0)), without a libm call; clamping in floating
+/// point first (NaN goes to 0) lets the cast be a 32-bit one.
 #[inline]
 fn cell_coords(p: DVec3, inv_cell: f64, last: usize) -> [usize; 3] {
-    let c = |x: f64| ((x * inv_cell).max(0.0) as usize).min(last);
+    let top = last as f64;
+    let c = |x: f64| (x * inv_cell).max(0.0).min(top) as u32 as usize;
     [c(p.x), c(p.y), c(p.z)]
 }
 
@@ -106,7 +124,9 @@ impl Level {
         self.cell_start.clear();
         self.cell_start
             .resize(self.side * self.side * self.side + 1, 0);
-        self.entries.clear();
+        self.balls.clear();
+        self.ids.clear();
+        self.keys.clear();
     }
 
     #[inline]
@@ -120,15 +140,22 @@ impl Level {
         ((x + 1) + self.side * ((y + 1) + self.side * (z + 1))) as u32
     }
 
-    /// Counting sort of `items` (ball, id, key), stable.
-    /// Counting sort of `items`, stable, in place: counts go to
-    /// `cell_start[key]`, inclusive prefix sums make that the end of each
+    fn resize(&mut self, n: usize) {
+        self.balls.clear();
+        self.balls.resize(n, Ball::default());
+        self.balls.push(NOWHERE);
+        self.ids.resize(n, 0);
+        self.keys.resize(n, 0);
+    }
+
+    /// Counting sort of `items` (ball, id, key), stable, in place: counts go
+    /// to `cell_start[key]`, inclusive prefix sums make that the end of each
     /// cell, and placing the items in reverse order walks each end down to
     /// the cell's start.
-    fn fill(&mut self, items: impl DoubleEndedIterator<Item = Entry> + Clone) {
-        for e in items.clone() {
-            self.reach_max = self.reach_max.max(e.reach);
-            self.cell_start[e.key as usize] += 1;
+    fn fill(&mut self, items: &[(Ball, u32, u32)]) {
+        for &(b, _, key) in items {
+            self.reach_max = self.reach_max.max(b.reach);
+            self.cell_start[key as usize] += 1;
         }
         let cells = self.cell_start.len() - 1;
         let mut sum = 0;
@@ -137,11 +164,14 @@ impl Level {
             *c = sum;
         }
         self.cell_start[cells] = sum;
-        self.entries.resize(sum as usize, Entry::default());
-        for e in items.rev() {
-            let slot = &mut self.cell_start[e.key as usize];
+        self.resize(sum as usize);
+        for &(b, id, key) in items.iter().rev() {
+            let slot = &mut self.cell_start[key as usize];
             *slot -= 1;
-            self.entries[*slot as usize] = e;
+            let at = *slot as usize;
+            self.balls[at] = b;
+            self.ids[at] = id;
+            self.keys[at] = key;
         }
     }
 
@@ -149,8 +179,8 @@ impl Level {
     /// by key range over the executor's lanes: each lane counts, sums and
     /// places only the keys of its range, into its own part of the cell
     /// table and of the entries, so the layout is the same for any number
-    /// of lanes. `keys[i]` is sphere `i`'s cell, `u32::MAX` for none.
-    fn fill_lanes(&mut self, keys: &[u32], balls: &[(DVec3, f64)], exec: &dyn Exec) {
+    /// of lanes.
+    fn fill_lanes(&mut self, staged: &[Staged], exec: &dyn Exec) {
         let cells = self.cell_start.len() - 1;
         let lanes = exec.lanes().clamp(1, 64).min(cells);
         let bounds: Vec<usize> = (0..=lanes).map(|l| l * cells / lanes).collect();
@@ -169,13 +199,19 @@ impl Level {
             let (lo, hi) = (bounds[l] as u32, bounds[l + 1] as u32);
             let mut table = tables[l].lock();
             let mut reach_max: f64 = 0.0;
-            for (&k, b) in keys.iter().zip(balls) {
-                if k >= lo && k < hi {
-                    table[(k - lo) as usize] += 1;
-                    reach_max = reach_max.max(b.1);
+            let mut count = 0;
+            for s in staged {
+                if s.key >= lo && s.key < hi {
+                    table[(s.key - lo) as usize] += 1;
+                    // Not `f64::max`: its NaN handling makes a slow chain
+                    // through every sphere, and reaches are never NaN here.
+                    if s.ball.reach > reach_max {
+                        reach_max = s.ball.reach;
+                    }
+                    count += 1;
                 }
             }
-            *totals[l].lock() = (table.iter().sum(), reach_max);
+            *totals[l].lock() = (count, reach_max);
         });
         let mut offsets = Vec::with_capacity(lanes + 1);
         let mut sum = 0u32;
@@ -186,13 +222,25 @@ impl Level {
             self.reach_max = self.reach_max.max(reach_max);
         }
         offsets.push(sum);
-        self.entries.resize(sum as usize, Entry::default());
-        let mut regions: Vec<Mutex<&mut [Entry]>> = Vec::with_capacity(lanes);
-        let mut rest = &mut self.entries[..];
+        self.balls.clear();
+        self.balls.resize(sum as usize, Ball::default());
+        self.balls.push(NOWHERE);
+        self.ids.resize(sum as usize, 0);
+        self.keys.resize(sum as usize, 0);
+        type Region<'a> = Mutex<(&'a mut [Ball], &'a mut [u32], &'a mut [u32])>;
+        let mut regions: Vec<Region> = Vec::with_capacity(lanes);
+        let (mut balls, mut ids, mut keys) = (
+            &mut self.balls[..sum as usize],
+            &mut self.ids[..],
+            &mut self.keys[..],
+        );
         for l in 0..lanes {
-            let (mine, more) = rest.split_at_mut((offsets[l + 1] - offsets[l]) as usize);
-            regions.push(Mutex::new(mine));
-            rest = more;
+            let len = (offsets[l + 1] - offsets[l]) as usize;
+            let (b, more_b) = balls.split_at_mut(len);
+            let (i, more_i) = ids.split_at_mut(len);
+            let (k, more_k) = keys.split_at_mut(len);
+            regions.push(Mutex::new((b, i, k)));
+            (balls, ids, keys) = (more_b, more_i, more_k);
         }
         exec.for_each_lane(&|l| {
             if l >= lanes {
@@ -205,17 +253,16 @@ impl Level {
                 end += *c;
                 *c = end;
             }
-            let mut out = regions[l].lock();
-            for (i, (&key, &(pos, reach))) in keys.iter().zip(balls).enumerate().rev() {
-                if key >= lo && key < hi {
-                    let slot = &mut table[(key - lo) as usize];
+            let mut region = regions[l].lock();
+            let (balls, ids, keys) = &mut *region;
+            for (i, s) in staged.iter().enumerate().rev() {
+                if s.key >= lo && s.key < hi {
+                    let slot = &mut table[(s.key - lo) as usize];
                     *slot -= 1;
-                    out[(*slot - offsets[l]) as usize] = Entry {
-                        pos,
-                        reach,
-                        id: i as u32,
-                        key,
-                    };
+                    let at = (*slot - offsets[l]) as usize;
+                    balls[at] = s.ball;
+                    ids[at] = i as u32;
+                    keys[at] = s.key;
                 }
             }
         });
@@ -227,43 +274,69 @@ impl Level {
         (self.cell_start.len() - 1).div_ceil(KEY_BLOCK)
     }
 
-    /// Entries of the cells with keys `k0..k1`: contiguous, keys being sorted.
-    #[inline]
-    fn keys_range(&self, k0: usize, k1: usize) -> &[Entry] {
-        &self.entries[self.cell_start[k0] as usize..self.cell_start[k1] as usize]
-    }
-
     /// Same-level pairs with a sphere in key block `b`, each found once: a
     /// sphere against the rest of its cell and the next cell along x, and the
     /// cells x-1..=x+1 of the four forward rows.
-    fn block_pairs(&self, b: usize, f: &mut impl FnMut(&Entry, &Entry)) {
+    fn block_pairs(&self, b: usize, f: &mut impl FnMut(u32, u32)) {
         let keys = self.cell_start.len() - 1;
         let cs = &self.cell_start[..];
-        let e = &self.entries[..];
+        let (balls, ids) = (&self.balls[..], &self.ids[..]);
+        let nowhere = (balls.len() - 1) as u32;
         let s = self.side;
         let mut k = cs[b * KEY_BLOCK] as usize;
         let hi = cs[((b + 1) * KEY_BLOCK).min(keys)] as usize;
         while k < hi {
-            let c = e[k].key as usize;
+            let c = self.keys[k] as usize;
             let end = cs[c + 1] as usize;
             let row_end = cs[c + 2] as usize;
             // Forward rows: (y+1, z), then (y-1..=y+1, z+1); x-1..=x+1 each.
             let (r1, r2) = (c + s - 1, c + s * s - s - 1);
             let (r3, r4) = (r2 + s, r2 + 2 * s);
             let windows = [
-                &e[cs[r1] as usize..cs[r1 + 3] as usize],
-                &e[cs[r2] as usize..cs[r2 + 3] as usize],
-                &e[cs[r3] as usize..cs[r3 + 3] as usize],
-                &e[cs[r4] as usize..cs[r4 + 3] as usize],
+                (cs[r1] as usize, cs[r1 + 3] as usize),
+                (cs[r2] as usize, cs[r2 + 3] as usize),
+                (cs[r3] as usize, cs[r3 + 3] as usize),
+                (cs[r4] as usize, cs[r4 + 3] as usize),
             ];
             for i in k..end {
-                let a = &e[i];
-                for b in &e[i + 1..row_end] {
-                    f(a, b);
-                }
-                for w in windows {
-                    for b in w {
-                        f(a, b);
+                let (a, ia) = (&balls[i], ids[i]);
+                // Nearly every window holds at most a few spheres, so copy
+                // four indices from each unconditionally and count only the
+                // real ones, then test the candidates four at a time, padded
+                // with `NOWHERE`: a loop that nearly always runs once, where
+                // five short loops had exits the branch predictor could not
+                // guess.
+                let mut buf = [nowhere; 4 * 6];
+                let mut len = 0;
+                let mut wide = false;
+                let mut gather = |lo: usize, hi: usize| {
+                    let l = lo as u32;
+                    buf[len..len + 4].copy_from_slice(&[l, l + 1, l + 2, l + 3]);
+                    len += (hi - lo).min(4);
+                    wide |= hi - lo > 4;
+                };
+                gather(i + 1, row_end);
+                gather(windows[0].0, windows[0].1);
+                gather(windows[1].0, windows[1].1);
+                gather(windows[2].0, windows[2].1);
+                gather(windows[3].0, windows[3].1);
+                buf[len..len + 4].copy_from_slice(&[nowhere; 4]);
+                if wide {
+                    scan(a, ia, &balls[i + 1..row_end], &ids[i + 1..row_end], f);
+                    for (lo, hi) in windows {
+                        scan(a, ia, &balls[lo..hi], &ids[lo..hi], f);
+                    }
+                } else {
+                    for four in buf[..len.next_multiple_of(4)].chunks_exact(4) {
+                        let near = |j: u32| within(a, &balls[j as usize]);
+                        // `|`, not `||`: all four tested without branches.
+                        if near(four[0]) | near(four[1]) | near(four[2]) | near(four[3]) {
+                            for &j in four {
+                                if near(j) {
+                                    f(ia, ids[j as usize]);
+                                }
+                            }
+                        }
                     }
                 }
             }
@@ -271,29 +344,54 @@ impl Level {
         }
     }
 
-    /// Entries in the cells covering `p ± span`.
-    fn near(&self, p: DVec3, span: f64, f: &mut impl FnMut(&Entry)) {
-        if self.entries.is_empty() {
+    /// Indices of the spheres in the cells covering `p ± span`.
+    fn near(&self, p: DVec3, span: f64, f: &mut impl FnMut(usize)) {
+        if self.ids.is_empty() {
             return;
         }
         let last = self.per_side - 1;
         let lo = cell_coords(p - DVec3::splat(span), self.inv_cell, last);
         let hi = cell_coords(p + DVec3::splat(span), self.inv_cell, last);
+        let cs = &self.cell_start;
+        // As in `block_pairs`: rows hold a sphere or two, so four indices
+        // are copied from each unconditionally and the real ones counted,
+        // and `f` runs in one loop instead of one short loop per row.
+        let mut buf = [0u32; 64];
+        let mut len = 0;
         for z in lo[2]..=hi[2] {
             for y in lo[1]..=hi[1] {
                 let k = (lo[0] + 1) + self.side * ((y + 1) + self.side * (z + 1));
-                for b in self.keys_range(k, k + hi[0] - lo[0] + 1) {
-                    f(b);
+                let (from, to) = (cs[k], cs[k + hi[0] - lo[0] + 1]);
+                if len + 4 > buf.len() || to - from > 4 {
+                    buf[..len].iter().for_each(|&j| f(j as usize));
+                    len = 0;
+                    if to - from > 4 {
+                        (from as usize..to as usize).for_each(&mut *f);
+                        continue;
+                    }
                 }
+                buf[len..len + 4].copy_from_slice(&[from, from + 1, from + 2, from + 3]);
+                len += (to - from) as usize;
             }
         }
+        buf[..len].iter().for_each(|&j| f(j as usize));
     }
 }
 
 #[inline(always)]
-fn within(a: &Entry, b: &Entry) -> bool {
+fn within(a: &Ball, b: &Ball) -> bool {
     let s = a.reach + b.reach;
     (a.pos - b.pos).length_squared() <= s * s
+}
+
+/// `f(ia, id)` for each of `balls` (with `ids`) within reach of `a`.
+#[inline(always)]
+fn scan(a: &Ball, ia: u32, balls: &[Ball], ids: &[u32], f: &mut impl FnMut(u32, u32)) {
+    for (b, id) in balls.iter().zip(ids) {
+        if within(a, b) {
+            f(ia, *id);
+        }
+    }
 }
 
 /// The work units of `pairs`, in the fixed order their results are joined.
@@ -325,44 +423,46 @@ impl Grid {
     ) {
         let n = spheres.len();
         self.top.clear();
-        self.balls.resize(n, (DVec3::ZERO, 0.0));
-        for_each_chunk(exec, &mut self.balls, BUILD_BLOCK, &|b, chunk| {
+        self.staged.resize(n, Staged::default());
+        for_each_chunk(exec, &mut self.staged, BUILD_BLOCK, &|b, chunk| {
             for (slot, s) in chunk.iter_mut().zip(&spheres[b * BUILD_BLOCK..]) {
-                *slot = ball(s);
+                let (pos, reach) = ball(s);
+                slot.ball = Ball { pos, reach };
             }
         });
         let mut depth = 0;
         if n > ALL_PAIRS_MAX {
-            // First level: keys in parallel, the sort serial.
+            // First level: keys in parallel, the sort by lanes.
             if self.levels.is_empty() {
                 self.levels.push(Level::default());
             }
-            let want = cell_for(self.balls.iter().map(|b| b.1), 8, &mut self.scratch);
+            let want = cell_for(
+                self.staged.iter().map(|s| s.ball.reach),
+                8,
+                &mut self.scratch,
+            );
             let level = &mut self.levels[0];
             level.shape(size, want, n);
-            self.keys.resize(n, 0);
             {
                 let level = &*level;
-                let balls = &self.balls;
-                for_each_chunk(exec, &mut self.keys, BUILD_BLOCK, &|b, chunk| {
-                    for (slot, &(pos, r)) in chunk.iter_mut().zip(&balls[b * BUILD_BLOCK..]) {
-                        *slot = if level.fits(r) {
-                            level.key_of(pos)
+                for_each_chunk(exec, &mut self.staged, BUILD_BLOCK, &|_, chunk| {
+                    for s in chunk {
+                        s.key = if level.fits(s.ball.reach) {
+                            level.key_of(s.ball.pos)
                         } else {
                             u32::MAX
                         };
                     }
                 });
             }
-            let (keys, balls) = (&self.keys, &self.balls);
-            level.fill_lanes(keys, balls, exec);
+            level.fill_lanes(&self.staged, exec);
             self.rest.clear();
             self.rest.extend(
-                keys.iter()
-                    .zip(balls)
+                self.staged
+                    .iter()
                     .enumerate()
-                    .filter(|(_, (k, _))| **k == u32::MAX)
-                    .map(|(i, (_, &(p, r)))| (p, r, i as u32)),
+                    .filter(|(_, s)| s.key == u32::MAX)
+                    .map(|(i, s)| (s.ball, i as u32)),
             );
             depth = 1;
             // Coarser levels for what did not fit, serially: they are few.
@@ -370,19 +470,14 @@ impl Grid {
                 if self.levels.len() == depth {
                     self.levels.push(Level::default());
                 }
-                let want = cell_for(self.rest.iter().map(|b| b.1), 1, &mut self.scratch);
+                let want = cell_for(self.rest.iter().map(|b| b.0.reach), 1, &mut self.scratch);
                 let level = &mut self.levels[depth];
                 level.shape(size, want, self.rest.len());
-                let placed: Vec<Entry> = self
+                let placed: Vec<(Ball, u32, u32)> = self
                     .rest
                     .iter()
-                    .filter(|b| level.fits(b.1))
-                    .map(|&(pos, reach, id)| Entry {
-                        pos,
-                        reach,
-                        id,
-                        key: level.key_of(pos),
-                    })
+                    .filter(|b| level.fits(b.0.reach))
+                    .map(|&(b, id)| (b, id, level.key_of(b.pos)))
                     .collect();
                 if placed.is_empty() {
                     // Balls wider than a one-cell level (the whole box) fit
@@ -390,29 +485,18 @@ impl Grid {
                     // against everything. Without this the loop never ends.
                     break;
                 }
-                level.fill(placed.iter().copied());
+                level.fill(&placed);
                 let cell = level.cell;
-                self.rest.retain(|b| 2.0 * b.1 > cell);
+                self.rest.retain(|b| 2.0 * b.0.reach > cell);
                 depth += 1;
             }
-            self.top
-                .extend(self.rest.iter().map(|&(pos, reach, id)| Entry {
-                    pos,
-                    reach,
-                    id,
-                    key: 0,
-                }));
+            self.top.extend_from_slice(&self.rest);
         } else {
             self.top.extend(
-                self.balls
+                self.staged
                     .iter()
                     .enumerate()
-                    .map(|(i, &(pos, reach))| Entry {
-                        pos,
-                        reach,
-                        id: i as u32,
-                        key: 0,
-                    }),
+                    .map(|(i, s)| (s.ball, i as u32)),
             );
         }
         self.levels.truncate(depth);
@@ -423,7 +507,7 @@ impl Grid {
         for (l, level) in self.levels.iter().enumerate() {
             units.extend((0..level.key_blocks()).map(|block| Unit::Block { level: l, block }));
             if l > 0 {
-                let n = level.entries.len();
+                let n = level.ids.len();
                 units.extend((0..n.div_ceil(CROSS_BLOCK)).map(|b| Unit::Cross {
                     level: l,
                     from: b * CROSS_BLOCK,
@@ -437,23 +521,35 @@ impl Grid {
         units
     }
 
-    fn unit_pairs(&self, unit: Unit, f: &mut impl FnMut(&Entry, &Entry)) {
+    /// The pairs of one unit within reach, as `f(id, id)`.
+    fn unit_pairs(&self, unit: Unit, f: &mut impl FnMut(u32, u32)) {
         match unit {
             Unit::Block { level, block } => self.levels[level].block_pairs(block, f),
             Unit::Cross { level, from, to } => {
-                for a in &self.levels[level].entries[from..to] {
+                let coarse = &self.levels[level];
+                for (a, &ia) in coarse.balls[from..to].iter().zip(&coarse.ids[from..to]) {
                     for finer in &self.levels[..level] {
-                        finer.near(a.pos, a.reach + finer.reach_max, &mut |b| f(a, b));
+                        finer.near(a.pos, a.reach + finer.reach_max, &mut |j| {
+                            if within(a, &finer.balls[j]) {
+                                f(ia, finer.ids[j]);
+                            }
+                        });
                     }
                 }
             }
             Unit::Top => {
-                for (k, a) in self.top.iter().enumerate() {
+                for (k, (a, ia)) in self.top.iter().enumerate() {
                     for level in &self.levels {
-                        level.near(a.pos, a.reach + level.reach_max, &mut |b| f(a, b));
+                        level.near(a.pos, a.reach + level.reach_max, &mut |j| {
+                            if within(a, &level.balls[j]) {
+                                f(*ia, level.ids[j]);
+                            }
+                        });
                     }
-                    for b in &self.top[k + 1..] {
-                        f(a, b);
+                    for (b, ib) in &self.top[k + 1..] {
+                        if within(a, b) {
+                            f(*ia, *ib);
+                        }
                     }
                 }
             }
@@ -477,9 +573,9 @@ impl Grid {
         for_each_block(exec, units.len(), &|u| {
             let mut v = this.slots[u].lock();
             v.clear();
-            this.unit_pairs(units[u], &mut |a, b| {
-                if within(a, b) && keep(a.id, b.id) {
-                    v.push((a.id, b.id));
+            this.unit_pairs(units[u], &mut |i, j| {
+                if keep(i, j) {
+                    v.push((i, j));
                 }
             });
         });
@@ -493,12 +589,13 @@ impl Grid {
     /// grown up to [`Grid::growth_cap`]; the caller applies its own test.
     pub fn near(&self, p: DVec3, reach: f64, f: &mut impl FnMut(u32, DVec3, f64)) {
         for level in &self.levels {
-            level.near(p, reach + 2.0 * level.reach_max, &mut |b| {
-                f(b.id, b.pos, b.reach)
+            level.near(p, reach + 2.0 * level.reach_max, &mut |j| {
+                let b = &level.balls[j];
+                f(level.ids[j], b.pos, b.reach)
             });
         }
-        for b in &self.top {
-            f(b.id, b.pos, b.reach);
+        for (b, id) in &self.top {
+            f(*id, b.pos, b.reach);
         }
     }
 
@@ -529,7 +626,7 @@ impl Grid {
         (
             self.levels
                 .iter()
-                .map(|l| (l.per_side, l.entries.len()))
+                .map(|l| (l.per_side, l.ids.len()))
                 .collect(),
             self.top.len(),
         )
