@@ -604,10 +604,13 @@ impl Grid {
     /// callers that track grown balls themselves, so a narrower search.
     pub fn near_binned(&self, p: DVec3, reach: f64, f: &mut impl FnMut(u32, DVec3, f64)) {
         for level in &self.levels {
-            level.near(p, reach + level.reach_max, &mut |b| f(b.id, b.pos, b.reach));
+            level.near(p, reach + level.reach_max, &mut |j| {
+                let b = &level.balls[j];
+                f(level.ids[j], b.pos, b.reach)
+            });
         }
-        for b in &self.top {
-            f(b.id, b.pos, b.reach);
+        for (b, id) in &self.top {
+            f(*id, b.pos, b.reach);
         }
     }
 
