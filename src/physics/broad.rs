@@ -78,6 +78,10 @@ pub struct Grid {
     /// Spheres not yet placed in a level: (ball, id).
     rest: Vec<(Ball, u32)>,
     scratch: Vec<f64>,
+    /// Per block of spheres: the widest reach, and the balls too wide for
+    /// the first level (found in parallel, joined in block order).
+    block_max: Vec<Mutex<f64>>,
+    wide: Vec<Mutex<Vec<(Ball, u32)>>>,
     slots: Vec<Mutex<Vec<Pair>>>,
 }
 
@@ -91,17 +95,18 @@ fn cell_coords(p: DVec3, inv_cell: f64, last: usize) -> [usize; 3] {
     [c(p.x), c(p.y), c(p.z)]
 }
 
-/// The 98th percentile of `reach` (estimated on every `stride`-th value: a
-/// function of the state only, so the grid, and the order pairs come out
-/// in, never depend on history) and the maximum.
+/// Twice the 98th percentile of `reach` (estimated on every `stride`-th
+/// value: a function of the state only, so the grid, and the order pairs
+/// come out in, never depend on history), or twice `max` when the fastest is
+/// close to the bulk.
 fn cell_for(
-    reaches: impl Iterator<Item = f64> + Clone,
+    reaches: impl Iterator<Item = f64>,
+    max: f64,
     stride: usize,
     scratch: &mut Vec<f64>,
 ) -> f64 {
     scratch.clear();
-    scratch.extend(reaches.clone().step_by(stride));
-    let max = reaches.fold(0.0f64, f64::max);
+    scratch.extend(reaches.step_by(stride));
     if scratch.is_empty() {
         return 2.0 * max;
     }
@@ -112,7 +117,10 @@ fn cell_for(
 }
 
 impl Level {
-    fn shape(&mut self, size: f64, want: f64, n: usize) {
+    /// Sizes the level for `n` spheres wanting cells of `want`. The cell
+    /// table is zeroed here unless `lanes_zero` (the lanes of `fill_lanes`
+    /// zero their own parts: at 100 000 spheres the table is megabytes).
+    fn shape(&mut self, size: f64, want: f64, n: usize, lanes_zero: bool) {
         // At most ~8 cells per sphere (empty cells cost nothing to skip)
         // and 1024 per side keep memory O(N).
         let cap = ((8 * n.max(1)) as f64).cbrt().ceil().clamp(1.0, 1024.0);
@@ -121,12 +129,13 @@ impl Level {
         self.cell = size / self.per_side as f64;
         self.inv_cell = 1.0 / self.cell;
         self.reach_max = 0.0;
-        self.cell_start.clear();
-        self.cell_start
-            .resize(self.side * self.side * self.side + 1, 0);
-        self.balls.clear();
-        self.ids.clear();
-        self.keys.clear();
+        let len = self.side * self.side * self.side + 1;
+        if lanes_zero {
+            self.cell_start.resize(len, 0);
+        } else {
+            self.cell_start.clear();
+            self.cell_start.resize(len, 0);
+        }
     }
 
     #[inline]
@@ -140,8 +149,10 @@ impl Level {
         ((x + 1) + self.side * ((y + 1) + self.side * (z + 1))) as u32
     }
 
+    /// Room for `n` entries and the `NOWHERE` pad; the old contents stay
+    /// (the scatter writes every slot), so no serial pass clears them.
     fn resize(&mut self, n: usize) {
-        self.balls.clear();
+        self.balls.truncate(n);
         self.balls.resize(n, Ball::default());
         self.balls.push(NOWHERE);
         self.ids.resize(n, 0);
@@ -198,6 +209,7 @@ impl Level {
             }
             let (lo, hi) = (bounds[l] as u32, bounds[l + 1] as u32);
             let mut table = tables[l].lock();
+            table.fill(0);
             let mut reach_max: f64 = 0.0;
             let mut count = 0;
             for s in staged {
@@ -222,11 +234,12 @@ impl Level {
             self.reach_max = self.reach_max.max(reach_max);
         }
         offsets.push(sum);
-        self.balls.clear();
-        self.balls.resize(sum as usize, Ball::default());
+        let sum_n = sum as usize;
+        self.balls.truncate(sum_n);
+        self.balls.resize(sum_n, Ball::default());
         self.balls.push(NOWHERE);
-        self.ids.resize(sum as usize, 0);
-        self.keys.resize(sum as usize, 0);
+        self.ids.resize(sum_n, 0);
+        self.keys.resize(sum_n, 0);
         type Region<'a> = Mutex<(&'a mut [Ball], &'a mut [u32], &'a mut [u32])>;
         let mut regions: Vec<Region> = Vec::with_capacity(lanes);
         let (mut balls, mut ids, mut keys) = (
@@ -424,11 +437,19 @@ impl Grid {
         let n = spheres.len();
         self.top.clear();
         self.staged.resize(n, Staged::default());
+        let blocks = n.div_ceil(BUILD_BLOCK);
+        self.block_max.resize_with(blocks, || Mutex::new(0.0));
+        let block_max = &self.block_max;
         for_each_chunk(exec, &mut self.staged, BUILD_BLOCK, &|b, chunk| {
+            let mut max: f64 = 0.0;
             for (slot, s) in chunk.iter_mut().zip(&spheres[b * BUILD_BLOCK..]) {
                 let (pos, reach) = ball(s);
                 slot.ball = Ball { pos, reach };
+                if reach > max {
+                    max = reach;
+                }
             }
+            *block_max[b].lock() = max;
         });
         let mut depth = 0;
         if n > ALL_PAIRS_MAX {
@@ -436,20 +457,29 @@ impl Grid {
             if self.levels.is_empty() {
                 self.levels.push(Level::default());
             }
+            let max = self.block_max[..blocks]
+                .iter()
+                .fold(0.0f64, |m, b| m.max(*b.lock()));
             let want = cell_for(
                 self.staged.iter().map(|s| s.ball.reach),
+                max,
                 8,
                 &mut self.scratch,
             );
             let level = &mut self.levels[0];
-            level.shape(size, want, n);
+            level.shape(size, want, n, true);
+            self.wide.resize_with(blocks, Default::default);
             {
                 let level = &*level;
-                for_each_chunk(exec, &mut self.staged, BUILD_BLOCK, &|_, chunk| {
-                    for s in chunk {
+                let wide = &self.wide;
+                for_each_chunk(exec, &mut self.staged, BUILD_BLOCK, &|b, chunk| {
+                    let mut wide = wide[b].lock();
+                    wide.clear();
+                    for (k, s) in chunk.iter_mut().enumerate() {
                         s.key = if level.fits(s.ball.reach) {
                             level.key_of(s.ball.pos)
                         } else {
+                            wide.push((s.ball, (b * BUILD_BLOCK + k) as u32));
                             u32::MAX
                         };
                     }
@@ -457,22 +487,24 @@ impl Grid {
             }
             level.fill_lanes(&self.staged, exec);
             self.rest.clear();
-            self.rest.extend(
-                self.staged
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, s)| s.key == u32::MAX)
-                    .map(|(i, s)| (s.ball, i as u32)),
-            );
+            for w in &self.wide[..blocks] {
+                self.rest.extend_from_slice(&w.lock());
+            }
             depth = 1;
             // Coarser levels for what did not fit, serially: they are few.
             while self.rest.len() > ALL_PAIRS_MAX {
                 if self.levels.len() == depth {
                     self.levels.push(Level::default());
                 }
-                let want = cell_for(self.rest.iter().map(|b| b.0.reach), 1, &mut self.scratch);
+                let max = self.rest.iter().fold(0.0f64, |m, b| m.max(b.0.reach));
+                let want = cell_for(
+                    self.rest.iter().map(|b| b.0.reach),
+                    max,
+                    1,
+                    &mut self.scratch,
+                );
                 let level = &mut self.levels[depth];
-                level.shape(size, want, self.rest.len());
+                level.shape(size, want, self.rest.len(), false);
                 let placed: Vec<(Ball, u32, u32)> = self
                     .rest
                     .iter()
