@@ -78,6 +78,7 @@ pub(super) struct Rounds {
     /// Slot → root slot, fixed during a round (the cluster's name).
     cluster_of: Vec<u32>,
     starts: Vec<u32>,
+    keys: Vec<u64>,
     order: Vec<u32>,
     pair_starts: Vec<u32>,
     pairs: Vec<(u32, u32)>,
@@ -264,27 +265,71 @@ impl Rounds {
             self.cluster_of[s as usize] = r;
         }
         let (cluster_of, dirty, slot, ids) = (&self.cluster_of, &self.dirty, &self.slot, &self.ids);
-        let member_roots = (0..m).filter_map(|s| {
-            let r = cluster_of[s];
-            dirty[r as usize].then_some((r, ids[s]))
-        });
-        group(&mut self.starts, &mut self.order, m, member_roots);
-        let pair_roots = meets.iter().filter_map(|&(i, j)| {
-            let r = cluster_of[slot[i as usize] as usize];
-            dirty[r as usize].then_some((r, (i, j)))
-        });
-        group(&mut self.pair_starts, &mut self.pairs, m, pair_roots);
         self.todo.clear();
-        for r in 0..m {
-            let (m0, m1) = (self.starts[r], self.starts[r + 1]);
-            if m1 > m0 {
-                self.todo.push(Todo {
-                    m0,
-                    m1,
-                    p0: self.pair_starts[r],
-                    p1: self.pair_starts[r + 1],
-                });
+        if self.stats.rounds == 0 {
+            // Everyone runs: group by counting sort.
+            let member_roots = (0..m).map(|s| (cluster_of[s], ids[s]));
+            group(&mut self.starts, &mut self.order, m, member_roots);
+            let pair_roots = meets
+                .iter()
+                .map(|&(i, j)| (cluster_of[slot[i as usize] as usize], (i, j)));
+            group(&mut self.pair_starts, &mut self.pairs, m, pair_roots);
+            for r in 0..m {
+                let (m0, m1) = (self.starts[r], self.starts[r + 1]);
+                if m1 > m0 {
+                    self.todo.push(Todo {
+                        m0,
+                        m1,
+                        p0: self.pair_starts[r],
+                        p1: self.pair_starts[r + 1],
+                    });
+                }
             }
+            return;
+        }
+        // Later rounds run a few merged clusters: sort just those.
+        self.keys.clear();
+        self.keys.extend(
+            (0..m)
+                .filter(|&s| dirty[cluster_of[s] as usize])
+                .map(|s| (cluster_of[s] as u64) << 32 | ids[s] as u64),
+        );
+        self.keys.sort_unstable();
+        self.order.clear();
+        self.order.extend(self.keys.iter().map(|&k| k as u32));
+        let mut k = 0;
+        while k < self.keys.len() {
+            let root = self.keys[k] >> 32;
+            let m0 = k;
+            while k < self.keys.len() && self.keys[k] >> 32 == root {
+                k += 1;
+            }
+            self.todo.push(Todo {
+                m0: m0 as u32,
+                m1: k as u32,
+                p0: root as u32,
+                p1: 0,
+            });
+        }
+        self.keys.clear();
+        self.keys
+            .extend(meets.iter().enumerate().filter_map(|(p, &(i, _))| {
+                let r = cluster_of[slot[i as usize] as usize];
+                dirty[r as usize].then_some((r as u64) << 32 | p as u64)
+            }));
+        self.keys.sort_unstable();
+        self.pairs.clear();
+        self.pairs
+            .extend(self.keys.iter().map(|&k| meets[k as u32 as usize]));
+        // Both are sorted by root: walk them together (`p0` held the root).
+        let mut p = 0;
+        for t in &mut self.todo {
+            let root = t.p0 as u64;
+            t.p0 = p as u32;
+            while p < self.keys.len() && self.keys[p] >> 32 == root {
+                p += 1;
+            }
+            t.p1 = p as u32;
         }
     }
 
