@@ -206,7 +206,11 @@ fn phases(label: &str, world: &World) {
         e.start_frame().unwrap();
         e.finish_frame().unwrap();
     }
-    let snapshot = (cpu_now() - t0) / steps as f64 - alone;
+    let framed = cpu_now() - t0;
+    let mut bare = ModelKind::Swept.build();
+    let t0 = cpu_now();
+    bare.advance(&mut w.clone(), DT, steps, &Serial);
+    let snapshot = (framed - (cpu_now() - t0)) / steps as f64;
     eprintln!(
         "phases {label}: CPU per step on one thread {:.1} ms; with lanes {:.1} ms = shareable \
          sections (grid binning, pair search, wall search, contact events in clusters, flight) \
