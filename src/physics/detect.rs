@@ -49,11 +49,11 @@ impl Detection {
                 let mut v = slots[b].lock();
                 v.clear();
                 let end = ((b + 1) * SPHERE_BLOCK).min(n);
-                v.extend(
-                    (b * SPHERE_BLOCK..end)
-                        .filter(|&i| wall(&spheres[i]))
-                        .map(|i| i as u32),
-                );
+                for (i, s) in spheres[b * SPHERE_BLOCK..end].iter().enumerate() {
+                    if wall(s) {
+                        v.push((b * SPHERE_BLOCK + i) as u32);
+                    }
+                }
             })
         };
         if exec.functional() {
