@@ -111,3 +111,44 @@ fn overlap_from_the_next_detection_matches_the_world() {
     Swept::default().advance(&mut reference, 1.0 / 60.0, 1, &Serial);
     assert_eq!(moved, reference);
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 24, ..Default::default() })]
+
+    /// Random crowded, fast, mass-spread scenes: clusters on 2 or 3 lanes
+    /// give the serial loop's bits, and the invariants of `swept` hold.
+    #[test]
+    fn random_scenes_match_the_serial_loop(
+        count in 2usize..600,
+        radius in 0.005f64..0.05,
+        speed in 0.1f64..8.0,
+        seed in proptest::prelude::any::<u64>(),
+        dt in 1e-3f64..0.05,
+        lanes in 2usize..4,
+        heavy in 1.0f64..1e4,
+    ) {
+        let Ok(mut start) = build_world(&SceneSpec {
+            count: Some(count),
+            radius: Some(radius),
+            speed: Some(speed),
+            seed: Some(seed),
+            ..Default::default()
+        }) else {
+            return Ok(());
+        };
+        for s in start.spheres.iter_mut().step_by(7) {
+            s.mass *= heavy;
+        }
+        let mut reference = start.clone();
+        Swept::default()
+            .serial_events(true)
+            .advance(&mut reference, dt, 8, &Serial);
+        let mut w = start.clone();
+        Swept::default().advance(&mut w, dt, 8, &Lanes(lanes));
+        proptest::prop_assert_eq!(&w, &reference);
+        proptest::prop_assert_eq!(w.escaped(), 0);
+        proptest::prop_assert!(w.max_overlap_rel() < 1e-9);
+        let (e0, e1) = (start.kinetic_energy(), w.kinetic_energy());
+        proptest::prop_assert!((e1 - e0).abs() <= 1e-12 * e0);
+    }
+}
