@@ -64,6 +64,9 @@ fn clusters_match_the_serial_event_loop() {
                     clusters > 10 * steps as usize,
                     "{scene}: {clusters} clusters"
                 );
+                // Conflicts happen in these scenes: merging and running
+                // again is exercised, not only the easy path.
+                assert!(reruns > 0 && rounds > 1, "{scene}: no cluster ran twice");
             }
             eprintln!("{scene}: {clusters} clusters, {reruns} reruns, up to {rounds} rounds");
         }
