@@ -72,13 +72,21 @@ impl EventQueue {
     /// such a branch).
     #[inline]
     pub fn update(&mut self, i: usize, t: f64) {
+        let pairs = &mut self.pairs[..];
+        if pairs.is_empty() {
+            return;
+        }
+        // Every index below is less than the power of two `pairs.len()`;
+        // masking with `len - 1` changes none of them and lets the compiler
+        // drop two bounds checks per level (a quarter of a climb's work).
+        let mask = pairs.len() - 1;
         let mut k = self.size + i;
-        *self.node(k) = Node { t, id: i as u32 };
+        pairs[(k >> 1) & mask][k & 1] = Node { t, id: i as u32 };
         while k > 1 {
             k >>= 1;
-            let pair = &self.pairs[k];
+            let pair = pairs[k & mask];
             let win = pair[right_wins(pair[0], pair[1]) as usize];
-            *self.node(k) = win;
+            pairs[(k >> 1) & mask][k & 1] = win;
         }
     }
 
