@@ -40,6 +40,9 @@ pub struct Predictor<'a> {
     bodies: &'a [Body],
     counts: &'a [u32],
     best: f64,
+    /// `best`, finite (an infinite one times zero would be NaN and pass the
+    /// cheap test); kept beside it so the test per candidate skips a `min`.
+    bound: f64,
     ev: Event,
 }
 
@@ -59,6 +62,7 @@ impl<'a> Predictor<'a> {
             bodies,
             counts,
             best: in_t,
+            bound: in_t.min(f64::MAX),
             ev: if in_t.is_finite() {
                 ev
             } else {
@@ -68,6 +72,7 @@ impl<'a> Predictor<'a> {
         let (tw, mask) = wall_toi(a, size);
         if tw < p.best {
             p.best = tw;
+            p.bound = tw.min(f64::MAX);
             p.ev = Event {
                 kind: Kind::Wall,
                 mask,
@@ -86,6 +91,7 @@ impl<'a> Predictor<'a> {
             bodies,
             counts,
             best: t,
+            bound: t.min(f64::MAX),
             ev,
         }
     }
@@ -106,7 +112,7 @@ impl<'a> Predictor<'a> {
         // the pairs approach, at random, so a branch on that alone
         // mispredicts half the time. A receding pair gets a limit of zero,
         // so only an overlapping one passes, and `pair_toi` turns it away.
-        let lim = -2.0 * bb.min(-0.0) * self.best.min(f64::MAX);
+        let lim = -2.0 * bb.min(-0.0) * self.bound;
         if c > lim {
             return;
         }
@@ -114,6 +120,7 @@ impl<'a> Predictor<'a> {
             && t < self.best
         {
             self.best = t;
+            self.bound = t;
             self.ev = Event {
                 kind: Kind::Pair,
                 mask: 0,
