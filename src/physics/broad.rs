@@ -82,9 +82,6 @@ pub struct Grid {
     /// the first level (found in parallel, joined in block order).
     block_max: Vec<Mutex<f64>>,
     wide: Vec<Mutex<Vec<(Ball, u32)>>>,
-    /// Per block of spheres, per lane: the spheres whose first-level keys
-    /// that lane sorts.
-    lists: Vec<Mutex<Vec<Vec<u32>>>>,
     slots: Vec<Mutex<Vec<Pair>>>,
 }
 
@@ -117,16 +114,6 @@ fn cell_for(
     let q = *scratch.select_nth_unstable_by(k, |a, b| a.total_cmp(b)).1;
     // When the fastest is close to the bulk, one level holds everyone.
     2.0 * if max <= 1.25 * q { max } else { q }
-}
-
-/// How many lanes sort a first level of `cells` cells.
-fn lane_count(exec: &dyn Exec, cells: usize) -> usize {
-    exec.lanes().clamp(1, 64).min(cells)
-}
-
-/// The key ranges of the lanes: lane `l` sorts keys `bounds[l]..bounds[l + 1]`.
-fn lane_bounds(cells: usize, lanes: usize) -> Vec<usize> {
-    (0..=lanes).map(|l| l * cells / lanes).collect()
 }
 
 impl Level {
@@ -204,34 +191,10 @@ impl Level {
     /// places only the keys of its range, into its own part of the cell
     /// table and of the entries, so the layout is the same for any number
     /// of lanes.
-    ///
-    /// `lists[b][l]`, when given, are the spheres of build block `b` whose
-    /// keys fall in lane `l`'s range, in order: a lane then reads only its
-    /// own spheres instead of scanning them all.
-    fn fill_lanes(&mut self, staged: &[Staged], lists: Option<&[Vec<Vec<u32>>]>, exec: &dyn Exec) {
+    fn fill_lanes(&mut self, staged: &[Staged], exec: &dyn Exec) {
         let cells = self.cell_start.len() - 1;
-        let lanes = lane_count(exec, cells);
-        let bounds = lane_bounds(cells, lanes);
-        // The spheres lane `l` sorts, in sphere order (`rev`: reversed),
-        // each handed to `f`; without lists, found by scanning all.
-        let mine = |l: usize, rev: bool, f: &mut dyn FnMut(usize)| match lists {
-            Some(lists) if rev => lists
-                .iter()
-                .rev()
-                .for_each(|b| b[l].iter().rev().for_each(|&i| f(i as usize))),
-            Some(lists) => lists
-                .iter()
-                .for_each(|b| b[l].iter().for_each(|&i| f(i as usize))),
-            None => {
-                let (lo, hi) = (bounds[l] as u32, bounds[l + 1] as u32);
-                let inside = |i: &usize| staged[*i].key >= lo && staged[*i].key < hi;
-                if rev {
-                    (0..staged.len()).rev().filter(inside).for_each(f)
-                } else {
-                    (0..staged.len()).filter(inside).for_each(f)
-                }
-            }
-        };
+        let lanes = exec.lanes().clamp(1, 64).min(cells);
+        let bounds: Vec<usize> = (0..=lanes).map(|l| l * cells / lanes).collect();
         let mut tables: Vec<Mutex<&mut [u32]>> = Vec::with_capacity(lanes);
         let mut rest = &mut self.cell_start[..cells];
         for l in 0..lanes {
@@ -244,21 +207,22 @@ impl Level {
             if l >= lanes {
                 return;
             }
-            let lo = bounds[l] as u32;
+            let (lo, hi) = (bounds[l] as u32, bounds[l + 1] as u32);
             let mut table = tables[l].lock();
             table.fill(0);
             let mut reach_max: f64 = 0.0;
             let mut count = 0;
-            mine(l, false, &mut |i| {
-                let s = &staged[i];
-                table[(s.key - lo) as usize] += 1;
-                // Not `f64::max`: its NaN handling makes a slow chain
-                // through every sphere, and reaches are never NaN here.
-                if s.ball.reach > reach_max {
-                    reach_max = s.ball.reach;
+            for s in staged {
+                if s.key >= lo && s.key < hi {
+                    table[(s.key - lo) as usize] += 1;
+                    // Not `f64::max`: its NaN handling makes a slow chain
+                    // through every sphere, and reaches are never NaN here.
+                    if s.ball.reach > reach_max {
+                        reach_max = s.ball.reach;
+                    }
+                    count += 1;
                 }
-                count += 1;
-            });
+            }
             *totals[l].lock() = (count, reach_max);
         });
         let mut offsets = Vec::with_capacity(lanes + 1);
@@ -295,7 +259,7 @@ impl Level {
             if l >= lanes {
                 return;
             }
-            let lo = bounds[l] as u32;
+            let (lo, hi) = (bounds[l] as u32, bounds[l + 1] as u32);
             let mut table = tables[l].lock();
             let mut end = offsets[l];
             for c in table.iter_mut() {
@@ -304,15 +268,16 @@ impl Level {
             }
             let mut region = regions[l].lock();
             let (balls, ids, keys) = &mut *region;
-            mine(l, true, &mut |i| {
-                let s = &staged[i];
-                let slot = &mut table[(s.key - lo) as usize];
-                *slot -= 1;
-                let at = (*slot - offsets[l]) as usize;
-                balls[at] = s.ball;
-                ids[at] = i as u32;
-                keys[at] = s.key;
-            });
+            for (i, s) in staged.iter().enumerate().rev() {
+                if s.key >= lo && s.key < hi {
+                    let slot = &mut table[(s.key - lo) as usize];
+                    *slot -= 1;
+                    let at = (*slot - offsets[l]) as usize;
+                    balls[at] = s.ball;
+                    ids[at] = i as u32;
+                    keys[at] = s.key;
+                }
+            }
         });
         drop(tables);
         self.cell_start[cells] = sum;
@@ -503,47 +468,24 @@ impl Grid {
             );
             let level = &mut self.levels[0];
             level.shape(size, want, n, true);
-            let cells = level.cell_start.len() - 1;
-            let lanes = lane_count(exec, cells);
-            let bounds = lane_bounds(cells, lanes);
             self.wide.resize_with(blocks, Default::default);
-            self.lists.resize_with(blocks, Default::default);
             {
                 let level = &*level;
-                let (wide, lists) = (&self.wide, &self.lists);
+                let wide = &self.wide;
                 for_each_chunk(exec, &mut self.staged, BUILD_BLOCK, &|b, chunk| {
                     let mut wide = wide[b].lock();
                     wide.clear();
-                    let mut lists = lists[b].lock();
-                    lists.resize_with(lanes, Vec::new);
-                    lists.iter_mut().for_each(Vec::clear);
                     for (k, s) in chunk.iter_mut().enumerate() {
-                        let i = (b * BUILD_BLOCK + k) as u32;
                         s.key = if level.fits(s.ball.reach) {
                             level.key_of(s.ball.pos)
                         } else {
-                            wide.push((s.ball, i));
+                            wide.push((s.ball, (b * BUILD_BLOCK + k) as u32));
                             u32::MAX
                         };
-                        if lanes > 1 && s.key != u32::MAX {
-                            let mut l = 0;
-                            while s.key as usize >= bounds[l + 1] {
-                                l += 1;
-                            }
-                            lists[l].push(i);
-                        }
                     }
                 });
             }
-            // Out of their locks, to be read by every lane at once.
-            let lists: Vec<Vec<Vec<u32>>> = self.lists[..blocks]
-                .iter_mut()
-                .map(|m| std::mem::take(m.get_mut()))
-                .collect();
-            level.fill_lanes(&self.staged, (lanes > 1).then_some(&lists[..]), exec);
-            for (m, l) in self.lists.iter_mut().zip(lists) {
-                *m.get_mut() = l;
-            }
+            level.fill_lanes(&self.staged, exec);
             self.rest.clear();
             for w in &self.wide[..blocks] {
                 self.rest.extend_from_slice(&w.lock());
