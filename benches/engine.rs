@@ -555,7 +555,7 @@ fn main() {
         ("swept N=100000 v=0.1, 5 steps/frame", &slow),
         ("swept N=100000 v=0.5, 5 steps/frame", &fast),
     ] {
-        paired(label, &mut engines(world, &modes, 5), 1, 10, 0);
+        paired(label, &mut engines(world, &modes, 5), 2, 25, 0);
     }
     let small = scene(20_000, 0.006, 0.5, 2);
     let passes = calibrate(&small);
