@@ -393,6 +393,9 @@ fn paired(label: &str, engines: &mut [(&str, Engine)], batch: usize, rounds: usi
         }
     }
     let names: Vec<&str> = engines.iter().map(|(n, _)| *n).collect();
+    if names.contains(&"pool2") {
+        capacity(label, rounds);
+    }
     for i in 0..names.len() {
         for j in i + 1..names.len() {
             let mut r: Vec<f64> = times[i].iter().zip(&times[j]).map(|(a, b)| a / b).collect();
@@ -412,6 +415,42 @@ fn paired(label: &str, engines: &mut [(&str, Engine)], batch: usize, rounds: usi
             );
         }
     }
+}
+
+/// What two threads buy on this machine right now, with nothing of ours in
+/// the way: a loop of arithmetic run twice on one thread against once on
+/// each of two pool threads, paired round by round. On a shared host the
+/// second core is not always there; pool figures are read against this.
+fn capacity(label: &str, rounds: usize) {
+    fn spin(seed: u64) -> u64 {
+        let mut x = seed;
+        for i in 0..4_000_000u64 {
+            x = x.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(i);
+        }
+        x
+    }
+    let pool = ballpit::engine::PoolExec::new(2).unwrap();
+    let mut r: Vec<f64> = (0..rounds)
+        .map(|_| {
+            let t0 = Instant::now();
+            black_box(spin(1));
+            black_box(spin(2));
+            let one = t0.elapsed().as_secs_f64();
+            let t0 = Instant::now();
+            pool.for_each_lane(&|l| {
+                black_box(spin(l as u64));
+            });
+            one / t0.elapsed().as_secs_f64()
+        })
+        .collect();
+    r.sort_by(f64::total_cmp);
+    eprintln!(
+        "paired {label}: the machine's own two-thread speed-up (arithmetic loop): median {:.2}x \
+         (min {:.2}, max {:.2}; {rounds} rounds)",
+        r[r.len() / 2],
+        r[0],
+        r[r.len() - 1]
+    );
 }
 
 fn engines(
