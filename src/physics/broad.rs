@@ -18,6 +18,8 @@ const ALL_PAIRS_MAX: usize = 24;
 const KEY_BLOCK: usize = 2048;
 /// Coarse-level spheres per parallel block of cross-level queries.
 const CROSS_BLOCK: usize = 64;
+/// Fewer spheres than this are sorted into the first level on one lane.
+const LANES_MIN_SPHERES: usize = 16_384;
 /// Spheres per parallel block while binning.
 const BUILD_BLOCK: usize = 4096;
 
@@ -193,6 +195,13 @@ impl Level {
     /// of lanes.
     fn fill_lanes(&mut self, staged: &[Staged], exec: &dyn Exec) {
         let cells = self.cell_start.len() - 1;
+        // Under this many spheres, waking other threads costs more than the
+        // sort; the layout is the same for any number of lanes.
+        let exec: &dyn Exec = if staged.len() < LANES_MIN_SPHERES {
+            &super::exec::Serial
+        } else {
+            exec
+        };
         let lanes = exec.lanes().clamp(1, 64).min(cells);
         let bounds: Vec<usize> = (0..=lanes).map(|l| l * cells / lanes).collect();
         let mut tables: Vec<Mutex<&mut [u32]>> = Vec::with_capacity(lanes);

@@ -26,6 +26,8 @@ use glam::DVec3;
 use parking_lot::Mutex;
 use std::sync::atomic::AtomicUsize;
 
+/// Fewer spheres with events than this run their clusters on one lane.
+const LANES_MIN_MEMBERS: usize = 512;
 /// Clusters per parallel block.
 const CLUSTER_BLOCK: usize = 16;
 /// Rounds run in parallel before the rest run as one absorbing cluster.
@@ -148,7 +150,12 @@ impl Rounds {
             } else {
                 self.stats.reruns += self.todo.len();
             }
-            let exec: &dyn Exec = if absorb { &Serial } else { exec };
+            // A few events are not worth waking other threads for.
+            let exec: &dyn Exec = if absorb || self.order.len() < LANES_MIN_MEMBERS {
+                &Serial
+            } else {
+                exec
+            };
             self.reserve(exec);
             let sh = Shared {
                 spheres,
