@@ -6,6 +6,12 @@
 //! contacts inside a step are followed, not missed. The rest fly straight.
 //! A pathological step (near jamming) is cut off by an event cap, finished
 //! in free flight and counted in `capped_steps`.
+//!
+//! The spheres with events are cut into clusters that cannot touch each
+//! other, each with its own event queue, run side by side on the executor's
+//! lanes ([`rounds`], [`cluster`]); the result is the serial loop's to the
+//! bit. The engine's overlap readout comes from the next step's detection,
+//! which that step then reuses.
 mod cluster;
 mod rounds;
 

@@ -4,13 +4,15 @@
 //! pairs that meet, and pairs of such spheres whose balls for the step
 //! overlap, end up in one cluster. Each cluster runs the serial event loop
 //! on its own (`cluster::Run`), on any lane. A run that finds it may touch
-//! a sphere outside its cluster stops; so do two clusters whose balls grew
-//! into each other. Those are merged (an outsider with no event joins) and
-//! run again, until a round ends with no conflict. After a few parallel
-//! rounds the rest run as one cluster that takes outsiders in as it meets
-//! them, which is the plain serial event loop. One lane runs clusters too:
-//! small event queues and rescans that check a few members directly cost
-//! less than one queue for the whole step.
+//! a sphere outside its cluster is void; so are two clusters whose balls
+//! grew into each other. Those are merged (an outsider with no event joins)
+//! and run again, until a round ends with no conflict. When rounds go on
+//! too long, or merging leaves most spheres to run again, or over 30 % of
+//! the spheres have events from the start (clusters percolate), everything
+//! runs as one cluster that takes outsiders in as it meets them: the plain
+//! serial event loop. One lane runs clusters too: small event queues and
+//! rescans that check a few members directly cost less than one queue for
+//! the whole step.
 //!
 //! The result is the serial loop's, bit for bit, however the clusters fall
 //! and whatever runs them: clusters that cannot touch each other have no
