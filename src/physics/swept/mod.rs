@@ -9,7 +9,7 @@
 //!
 //! The spheres with events are cut into clusters that cannot touch each
 //! other, each with its own event queue, run side by side on the executor's
-//! lanes ([`rounds`], [`cluster`]); the result is the serial loop's to the
+//! lanes (`rounds.rs`, `cluster.rs`); the result is the serial loop's to the
 //! bit. The engine's overlap readout comes from the next step's detection,
 //! which that step then reuses.
 mod cluster;
