@@ -161,3 +161,41 @@ proptest::proptest! {
         proptest::prop_assert!((e1 - e0).abs() <= 1e-12 * e0);
     }
 }
+
+/// Enough spheres with events that the clusters really go out to the lanes
+/// (small steps stay on one), with conflicts and reruns among them.
+#[test]
+fn many_events_run_on_the_lanes_and_match() {
+    let start = build_world(&SceneSpec {
+        scene: Some("gas".into()),
+        count: Some(30_000),
+        radius: Some(0.005),
+        speed: Some(0.8),
+        seed: Some(5),
+        ..Default::default()
+    })
+    .unwrap();
+    let mut reference = start.clone();
+    Swept::default()
+        .serial_events(true)
+        .advance(&mut reference, 1.0 / 60.0, 3, &Serial);
+    for lanes in [2, 3] {
+        let mut w = start.clone();
+        let mut m = Swept::default();
+        let mut reruns = 0;
+        for _ in 0..3 {
+            m.advance(&mut w, 1.0 / 60.0, 1, &Lanes(lanes));
+            let s = m.round_stats();
+            assert!(s.involved > 1000, "only {} spheres with events", s.involved);
+            assert!(s.clusters > 100, "{} clusters", s.clusters);
+            reruns += s.reruns;
+        }
+        assert!(reruns > 0, "no cluster ran twice");
+        assert_eq!(w, reference, "{lanes} lanes");
+    }
+    // And on real threads.
+    let pool = ballpit::engine::PoolExec::new(2).unwrap();
+    let mut w = start.clone();
+    Swept::default().advance(&mut w, 1.0 / 60.0, 3, &pool);
+    assert_eq!(w, reference, "pool of 2 threads");
+}
