@@ -28,6 +28,8 @@ use glam::DVec3;
 use parking_lot::Mutex;
 use std::sync::atomic::AtomicUsize;
 
+/// Fewer grown balls than this are compared on one lane.
+const LANES_MIN_BALLS: usize = 8192;
 /// Fewer spheres with events than this run their clusters on one lane.
 const LANES_MIN_MEMBERS: usize = 512;
 /// Clusters per parallel block.
@@ -464,8 +466,12 @@ impl Rounds {
             let r = self.find(s);
             self.cluster_of[s as usize] = r;
         }
-        self.overlap
-            .build(&self.balls, size, |b| (b.pos, b.radius), exec);
+        self.overlap.build(
+            &self.balls,
+            size,
+            |b| (b.pos, b.radius),
+            small(exec, self.balls.len()),
+        );
         let mut pairs = std::mem::take(&mut self.overlap_pairs);
         let (out, slots, cluster_of) = (&self.out, &self.grown_slots, &self.cluster_of);
         let grew = |k: u32| out[slots[k as usize] as usize].is_some_and(|m| m.grew);
@@ -473,7 +479,8 @@ impl Rounds {
             let (sa, sb) = (slots[a as usize] as usize, slots[b as usize] as usize);
             (grew(a) || grew(b)) && cluster_of[sa] != cluster_of[sb]
         };
-        self.overlap.pairs(exec, &apart, &mut pairs);
+        self.overlap
+            .pairs(small(exec, self.balls.len()), &apart, &mut pairs);
         for &(a, b) in &pairs {
             let (sa, sb) = (self.grown_slots[a as usize], self.grown_slots[b as usize]);
             self.conflicts
@@ -566,4 +573,10 @@ fn group<T: Copy + Default>(
         starts[k] = starts[k - 1];
     }
     starts[0] = 0;
+}
+
+/// `exec`, or the calling thread when `n` items are too few to be worth
+/// handing to other threads (each hand-off costs tens of microseconds).
+fn small(exec: &dyn Exec, n: usize) -> &dyn Exec {
+    if n < LANES_MIN_BALLS { &Serial } else { exec }
 }
