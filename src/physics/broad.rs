@@ -118,6 +118,17 @@ fn cell_for(
     2.0 * if max <= 1.25 * q { max } else { q }
 }
 
+/// Room for `n` entries and the `NOWHERE` pad; the old contents stay (the
+/// scatter writes every slot), so no serial pass clears them. Takes the
+/// fields, not the level, so it can run while the cell table is lent out.
+fn room(balls: &mut Vec<Ball>, ids: &mut Vec<u32>, keys: &mut Vec<u32>, n: usize) {
+    balls.truncate(n);
+    balls.resize(n, Ball::default());
+    balls.push(NOWHERE);
+    ids.resize(n, 0);
+    keys.resize(n, 0);
+}
+
 impl Level {
     /// Sizes the level for `n` spheres wanting cells of `want`. The cell
     /// table is zeroed here unless `lanes_zero` (the lanes of `fill_lanes`
@@ -151,16 +162,6 @@ impl Level {
         ((x + 1) + self.side * ((y + 1) + self.side * (z + 1))) as u32
     }
 
-    /// Room for `n` entries and the `NOWHERE` pad; the old contents stay
-    /// (the scatter writes every slot), so no serial pass clears them.
-    fn resize(&mut self, n: usize) {
-        self.balls.truncate(n);
-        self.balls.resize(n, Ball::default());
-        self.balls.push(NOWHERE);
-        self.ids.resize(n, 0);
-        self.keys.resize(n, 0);
-    }
-
     /// Counting sort of `items` (ball, id, key), stable, in place: counts go
     /// to `cell_start[key]`, inclusive prefix sums make that the end of each
     /// cell, and placing the items in reverse order walks each end down to
@@ -177,7 +178,7 @@ impl Level {
             *c = sum;
         }
         self.cell_start[cells] = sum;
-        self.resize(sum as usize);
+        room(&mut self.balls, &mut self.ids, &mut self.keys, sum as usize);
         for &(b, id, key) in items.iter().rev() {
             let slot = &mut self.cell_start[key as usize];
             *slot -= 1;
@@ -243,12 +244,7 @@ impl Level {
             self.reach_max = self.reach_max.max(reach_max);
         }
         offsets.push(sum);
-        let sum_n = sum as usize;
-        self.balls.truncate(sum_n);
-        self.balls.resize(sum_n, Ball::default());
-        self.balls.push(NOWHERE);
-        self.ids.resize(sum_n, 0);
-        self.keys.resize(sum_n, 0);
+        room(&mut self.balls, &mut self.ids, &mut self.keys, sum as usize);
         type Region<'a> = Mutex<(&'a mut [Ball], &'a mut [u32], &'a mut [u32])>;
         let mut regions: Vec<Region> = Vec::with_capacity(lanes);
         let (mut balls, mut ids, mut keys) = (
