@@ -325,7 +325,7 @@ impl Rounds {
             self.todo.push(Todo {
                 m0: m0 as u32,
                 m1: k as u32,
-                p0: root as u32,
+                p0: 0,
                 p1: 0,
             });
         }
@@ -339,10 +339,10 @@ impl Rounds {
         self.pairs.clear();
         self.pairs
             .extend(self.keys.iter().map(|&k| meets[k as u32 as usize]));
-        // Both are sorted by root: walk them together (`p0` held the root).
+        // Both are sorted by root: walk them together.
         let mut p = 0;
         for t in &mut self.todo {
-            let root = t.p0 as u64;
+            let root = cluster_of[slot[self.order[t.m0 as usize] as usize] as usize] as u64;
             t.p0 = p as u32;
             while p < self.keys.len() && self.keys[p] >> 32 == root {
                 p += 1;
