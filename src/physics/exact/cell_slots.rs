@@ -13,7 +13,9 @@ pub const BLOCK: usize = 3;
 
 #[derive(Clone, Debug, Default)]
 pub struct CellSlots {
-    /// Per cell: the first `BLOCK` spheres, then the count.
+    /// Per cell: the first `BLOCK` spheres, then the count; padded with
+    /// empty cells to a power of two, so a stencil's index can be masked
+    /// instead of checked.
     blocks: Vec<[u32; BLOCK + 1]>,
     /// Per cell: spheres `BLOCK..count` (empty almost always).
     overflow: Vec<Vec<u32>>,
@@ -27,7 +29,7 @@ impl CellSlots {
         self.at.clear();
         self.at.resize(spheres, (NONE, NONE));
         self.blocks.clear();
-        self.blocks.resize(cells, [0; BLOCK + 1]);
+        self.blocks.resize(cells.next_power_of_two(), [0; BLOCK + 1]);
         self.overflow.clear();
         self.overflow.resize(cells, Vec::new());
     }
@@ -131,6 +133,47 @@ impl CellSlots {
                 out.extend_from_slice(&self.overflow[base + o]);
             }
             n = out.len();
+        }
+        n
+    }
+}
+
+impl CellSlots {
+    /// [`Self::gather`] for a stencil of a fixed `K` cells (the 27 around a
+    /// cell, the 9 a crossing brings), all within the grid: per cell one
+    /// masked index, one 16-byte copy and two adds, no clamp and no bounds
+    /// check. A count over `BLOCK` anywhere falls back to [`Self::gather`].
+    #[inline(always)]
+    pub fn gather_stencil<const K: usize>(
+        &self,
+        base: usize,
+        offsets: &[usize; K],
+        out: &mut Vec<u32>,
+    ) -> usize {
+        const { assert!(K * (BLOCK + 1) <= WINDOW) };
+        if out.len() < WINDOW + BLOCK + 1 {
+            out.resize(WINDOW + BLOCK + 1, 0);
+        }
+        let window: &mut [u32; WINDOW + BLOCK + 1] = (&mut out[..WINDOW + BLOCK + 1])
+            .try_into()
+            .expect("room made above");
+        let blocks = &self.blocks[..];
+        // A power of two (see `reset`); the mask never bites for cells in
+        // the grid.
+        let mask = blocks.len() - 1;
+        let mut n = 0;
+        let mut counts = 0;
+        for &o in offsets {
+            let b = &blocks[(base + o) & mask];
+            // Each count is at most BLOCK on this path, so `n` stays within
+            // the window; the mask only lets the compiler see that.
+            let at = n & (WINDOW - 1);
+            window[at..at + BLOCK + 1].copy_from_slice(b);
+            counts |= b[BLOCK];
+            n += b[BLOCK] as usize;
+        }
+        if counts as usize > BLOCK {
+            return self.gather(base, offsets, out);
         }
         n
     }

@@ -196,7 +196,7 @@ impl Cells {
             self.list.gather(0, &cells, out)
         } else {
             let corner = self.list.cell(i) as usize - self.stencil[0];
-            self.list.gather(corner, &self.stencil, out)
+            self.list.gather_stencil(corner, &self.stencil, out)
         };
         if self.bigs.is_empty() {
             return n;
@@ -214,7 +214,7 @@ impl Cells {
     #[inline]
     pub fn new_candidates(&self, i: usize, mask: u8, out: &mut Vec<u32>) -> usize {
         let corner = self.list.cell(i) as usize - self.stencil[0];
-        self.list.gather(corner, &self.layers[mask as usize], out)
+        self.list.gather_stencil(corner, &self.layers[mask as usize], out)
     }
 
     fn coords(&self, p: DVec3) -> [usize; 3] {
