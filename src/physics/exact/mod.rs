@@ -370,8 +370,11 @@ impl Exact {
                     self.stats.pairs += 1;
                     self.bodies[j].advance(t);
                     self.collide(i, j, c);
-                    self.schedule(i);
-                    self.schedule(j);
+                    let (ti, evi) = self.predict(i);
+                    let (tj, evj) = self.predict(j);
+                    self.events[i] = evi;
+                    self.events[j] = evj;
+                    self.queue.update_two(i, ti, j, tj);
                 }
                 Kind::Wall => {
                     self.stats.walls += 1;

@@ -91,6 +91,36 @@ impl EventQueue {
         }
     }
 
+    /// [`Self::update`] for two spheres at once (the two of a contact): each
+    /// climbs to where their paths meet, and the rest is climbed once.
+    #[inline]
+    pub fn update_two(&mut self, i: usize, ti: f64, j: usize, tj: f64) {
+        let nodes = self.pairs.as_flattened_mut();
+        if nodes.is_empty() || i == j {
+            self.update(i, ti);
+            return self.update(j, tj);
+        }
+        let mask = nodes.len() - 1;
+        let (mut a, mut b) = (self.size + i, self.size + j);
+        nodes[a & mask] = Node { t: ti, id: i as u32 };
+        nodes[b & mask] = Node { t: tj, id: j as u32 };
+        // Both leaves are set before any parent is taken, so a parent the
+        // two share sees both.
+        while a != b {
+            for k in [a, b] {
+                let pair = [nodes[(k & !1) & mask], nodes[(k | 1) & mask]];
+                nodes[(k >> 1) & mask] = pair[right_wins(pair[0], pair[1]) as usize];
+            }
+            a >>= 1;
+            b >>= 1;
+        }
+        while a > 1 {
+            let pair = [nodes[(a & !1) & mask], nodes[(a | 1) & mask]];
+            a >>= 1;
+            nodes[a & mask] = pair[right_wins(pair[0], pair[1]) as usize];
+        }
+    }
+
     /// The earliest pending event: time and sphere (time infinite if none).
     #[inline]
     pub fn peek(&self) -> (f64, usize) {
@@ -154,6 +184,27 @@ mod tests {
         assert_eq!(q.time_of(0), 10.0);
         q.shift(0.5);
         assert_eq!(q.peek(), (0.0, 2));
+    }
+
+    /// Pairs of updates at once give the tree single updates give.
+    #[test]
+    fn update_two_matches_two_updates() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(5);
+        for n in [2, 3, 64, 100] {
+            let (mut one, mut two) = (EventQueue::default(), EventQueue::default());
+            one.reset(n);
+            two.reset(n);
+            for _ in 0..3000 {
+                let (i, j) = (rng.random_range(0..n), rng.random_range(0..n));
+                let ti = rng.random_range(0..6) as f64;
+                let tj = rng.random_range(0..6) as f64;
+                one.update(i, ti);
+                one.update(j, tj);
+                two.update_two(i, ti, j, tj);
+                assert_eq!(one.pairs, two.pairs);
+            }
+        }
     }
 
     /// Random updates with many equal times (and infinities), against a
