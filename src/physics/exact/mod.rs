@@ -290,7 +290,10 @@ impl Exact {
         let (tc, ev) = cells.next_event(i, a);
         let tc = a.t + tc;
         let (tp, evp) = self.pending[i];
-        if tc <= tp { (tc, ev) } else { (tp, evp) }
+        // By index: which comes first is random, and a branch on it
+        // mispredicted a third of the time.
+        let first = (tc <= tp) as usize;
+        ([tp, tc][first], [evp, ev][first])
     }
 
     #[inline]
