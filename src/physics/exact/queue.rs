@@ -8,86 +8,99 @@
 //! Simultaneous events pop in sphere-index order (lower index first): the
 //! fixed order that makes runs reproducible.
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct Node {
-    t: f64,
-    id: u32,
-}
-
-impl Node {
-    const EMPTY: Node = Node {
-        t: f64::INFINITY,
-        id: u32::MAX,
-    };
-}
-
-/// Whether the right child of a pair beats the left. Ties go left, and the
-/// left subtree holds the lower indices, so every inner node holds the
-/// earliest event of its subtree, the lowest index among equal times,
-/// without comparing indices.
+/// A time as a `u64` whose unsigned order is the time's order (`-0` is
+/// taken as `+0`, so the two tie as before): the climb compares integers,
+/// which LLVM keeps as a conditional move where a select on two `f64`s
+/// became a random branch.
 #[inline(always)]
-fn right_wins(l: Node, r: Node) -> bool {
-    r.t < l.t
+fn key(t: f64) -> u64 {
+    let bits = (t + 0.0).to_bits();
+    bits ^ ((((bits as i64) >> 63) as u64) | (1 << 63))
+}
+
+#[inline(always)]
+fn time(key: u64) -> f64 {
+    f64::from_bits(key ^ (!(((key as i64) >> 63) as u64) | (1 << 63)))
 }
 
 #[derive(Clone, Debug, Default)]
 pub struct EventQueue {
-    /// Node `k` is `pairs[k / 2][k % 2]`, which is also index `k` of the
-    /// flattened slice (the climb's view): siblings side by side. Leaves are
-    /// nodes `size..2*size`, the root is node 1; node 0 is unused.
-    pairs: Vec<[Node; 2]>,
+    /// Node `k`: the key of its event's time and the sphere. Leaves are
+    /// nodes `size..2*size`, the root is node 1; node 0 is unused. Keys and
+    /// spheres apart, so a climb carries the winning key in a register and
+    /// only the keys are on its chain of dependent steps.
+    keys: Vec<u64>,
+    ids: Vec<u32>,
     size: usize,
+}
+
+/// One step of a climb from node `k` (of a power-of-two tree, `mask` its
+/// length less one), which holds `w`: set its parent, and return the
+/// parent's key. Ties go left (lower indices), so a left sibling wins
+/// a tie too: hence the `+ (k & 1)`. Every index is below the length, so the
+/// masks change none and let the compiler drop the bounds checks.
+#[inline(always)]
+fn step(keys: &mut [u64], ids: &mut [u32], mask: usize, k: usize, w: u64) -> u64 {
+    let s = keys[(k ^ 1) & mask];
+    let sib = s < w.wrapping_add((k & 1) as u64);
+    let w = w ^ ((w ^ s) & 0u64.wrapping_sub(sib as u64));
+    let id = ids[(k ^ sib as usize) & mask];
+    keys[(k >> 1) & mask] = w;
+    ids[(k >> 1) & mask] = id;
+    w
 }
 
 impl EventQueue {
     /// A queue for spheres `0..n`, every event at infinity.
     pub fn reset(&mut self, n: usize) {
         self.size = n.next_power_of_two().max(1);
-        self.pairs.clear();
-        self.pairs.resize(self.size, [Node::EMPTY; 2]);
-    }
-
-    #[inline(always)]
-    fn node(&mut self, k: usize) -> &mut Node {
-        &mut self.pairs[k >> 1][k & 1]
+        self.keys.clear();
+        self.keys.resize(2 * self.size, key(f64::INFINITY));
+        self.ids.clear();
+        self.ids.resize(2 * self.size, u32::MAX);
     }
 
     /// Set the leaves without rebuilding the tree; call [`Self::rebuild`] after.
     #[inline]
     pub fn set_leaf(&mut self, i: usize, t: f64) {
-        *self.node(self.size + i) = Node { t, id: i as u32 };
+        self.keys[self.size + i] = key(t);
+        self.ids[self.size + i] = i as u32;
     }
 
     pub fn rebuild(&mut self) {
         for k in (1..self.size).rev() {
-            let [l, r] = self.pairs[k];
-            *self.node(k) = if right_wins(l, r) { r } else { l };
+            let right = (self.keys[2 * k + 1] < self.keys[2 * k]) as usize;
+            self.keys[k] = self.keys[2 * k + right];
+            self.ids[k] = self.ids[2 * k + right];
         }
     }
 
-    /// Sphere `i`'s pending event is now at `t`. Climbs to the root always,
-    /// and picks each winner by indexing: stopping early where the winner
-    /// stays saves little, and a branch on either the stop or the
-    /// comparison is taken at random (LLVM turns a plain select back into
-    /// such a branch).
+    /// The two arrays as slices of one power-of-two length, and that length
+    /// less one (`None` before any reset).
+    #[inline(always)]
+    fn nodes(&mut self) -> Option<(&mut [u64], &mut [u32], usize)> {
+        let len = self.keys.len();
+        if len == 0 {
+            return None;
+        }
+        Some((&mut self.keys[..len], &mut self.ids[..len], len - 1))
+    }
+
+    /// Sphere `i`'s pending event is now at `t`. Climbs to the root always:
+    /// stopping early where the winner stays saves little, and a branch on
+    /// either the stop or the comparison is taken at random.
     #[inline]
     pub fn update(&mut self, i: usize, t: f64) {
-        // Nodes in one flat slice (node `k` at index `k`): every index below
-        // is less than its power-of-two length, so masking with `len - 1`
-        // changes none of them and lets the compiler drop the bounds checks
-        // (a quarter of a climb's work), and the sibling and parent indices
-        // are one bit operation each.
-        let nodes = self.pairs.as_flattened_mut();
-        if nodes.is_empty() {
-            return;
-        }
-        let mask = nodes.len() - 1;
         let mut k = self.size + i;
-        nodes[k & mask] = Node { t, id: i as u32 };
+        let Some((keys, ids, mask)) = self.nodes() else {
+            return;
+        };
+        let mut w = key(t);
+        keys[k & mask] = w;
+        ids[k & mask] = i as u32;
         while k > 1 {
-            let pair = [nodes[(k & !1) & mask], nodes[(k | 1) & mask]];
+            w = step(keys, ids, mask, k, w);
             k >>= 1;
-            nodes[k & mask] = pair[right_wins(pair[0], pair[1]) as usize];
         }
     }
 
@@ -95,53 +108,51 @@ impl EventQueue {
     /// climbs to where their paths meet, and the rest is climbed once.
     #[inline]
     pub fn update_two(&mut self, i: usize, ti: f64, j: usize, tj: f64) {
-        let nodes = self.pairs.as_flattened_mut();
-        if nodes.is_empty() || i == j {
+        if i == j {
             self.update(i, ti);
             return self.update(j, tj);
         }
-        let mask = nodes.len() - 1;
         let (mut a, mut b) = (self.size + i, self.size + j);
-        nodes[a & mask] = Node { t: ti, id: i as u32 };
-        nodes[b & mask] = Node { t: tj, id: j as u32 };
-        // Both leaves are set before any parent is taken, so a parent the
-        // two share sees both.
+        let Some((keys, ids, mask)) = self.nodes() else {
+            return;
+        };
+        let (mut wa, mut wb) = (key(ti), key(tj));
+        keys[a & mask] = wa;
+        ids[a & mask] = i as u32;
+        keys[b & mask] = wb;
+        ids[b & mask] = j as u32;
+        // Both nodes of a level are set before either parent is taken, so
+        // a parent the two share sees both.
         while a != b {
-            for k in [a, b] {
-                let pair = [nodes[(k & !1) & mask], nodes[(k | 1) & mask]];
-                nodes[(k >> 1) & mask] = pair[right_wins(pair[0], pair[1]) as usize];
-            }
+            let pa = step(keys, ids, mask, a, wa);
+            wb = step(keys, ids, mask, b, wb);
+            wa = pa;
             a >>= 1;
             b >>= 1;
         }
         while a > 1 {
-            let pair = [nodes[(a & !1) & mask], nodes[(a | 1) & mask]];
+            wa = step(keys, ids, mask, a, wa);
             a >>= 1;
-            nodes[a & mask] = pair[right_wins(pair[0], pair[1]) as usize];
         }
     }
 
     /// The earliest pending event: time and sphere (time infinite if none).
     #[inline]
     pub fn peek(&self) -> (f64, usize) {
-        let n = self.pairs[0][1];
-        (n.t, n.id as usize)
+        (time(self.keys[1]), self.ids[1] as usize)
     }
 
     /// Time of sphere `i`'s pending event.
     #[inline]
     pub fn time_of(&self, i: usize) -> f64 {
-        let k = self.size + i;
-        self.pairs[k >> 1][k & 1].t
+        time(self.keys[self.size + i])
     }
 
     /// Subtract `shift` from every time (a new time origin); order is kept
     /// because subtraction of a constant is monotone under rounding.
     pub fn shift(&mut self, shift: f64) {
-        for pair in &mut self.pairs[self.size / 2..] {
-            for node in pair {
-                node.t -= shift;
-            }
+        for k in &mut self.keys[self.size..] {
+            *k = key(time(*k) - shift);
         }
         self.rebuild();
     }
@@ -202,9 +213,33 @@ mod tests {
                 one.update(i, ti);
                 one.update(j, tj);
                 two.update_two(i, ti, j, tj);
-                assert_eq!(one.pairs, two.pairs);
+                assert_eq!((&one.keys, &one.ids), (&two.keys, &two.ids));
             }
         }
+    }
+
+    /// The key keeps every time and its order (minus zero ties plus zero).
+    #[test]
+    fn keys_order_like_times() {
+        let times = [
+            f64::NEG_INFINITY,
+            -3.5,
+            -f64::MIN_POSITIVE,
+            0.0,
+            5e-324,
+            1e-300,
+            0.25,
+            1.0,
+            f64::MAX,
+            f64::INFINITY,
+        ];
+        for (a, &ta) in times.iter().enumerate() {
+            assert_eq!(time(key(ta)), ta);
+            for &tb in &times[a + 1..] {
+                assert!(key(ta) < key(tb), "{ta} vs {tb}");
+            }
+        }
+        assert_eq!(key(-0.0), key(0.0));
     }
 
     /// Random updates with many equal times (and infinities), against a
