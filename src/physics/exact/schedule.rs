@@ -113,7 +113,13 @@ impl<'a> Predictor<'a> {
         // mispredicts half the time. A receding pair gets a limit of zero,
         // so only an overlapping one passes, and `pair_toi` turns it away.
         let lim = -2.0 * bb.min(-0.0) * self.bound;
-        if c > lim {
+        // And pairs that miss (no real root, as `pair_toi` finds), in the
+        // same branch: passing the test is what mispredicts, so the fewer
+        // pass the better.
+        // As one `max` (the sign of a difference of floats is exact, so
+        // these are `c > lim` and `bb * bb < a c`): LLVM split a plain `|`
+        // of the two into a branch on the sign of `bb`.
+        if (c - lim).max(dv.length_squared() * c - bb * bb) > 0.0 {
             return;
         }
         if let Some(t) = pair_toi(dp, dv, sigma)
