@@ -108,17 +108,17 @@ impl<'a> Predictor<'a> {
         let c = dp.length_squared() - sigma * sigma;
         // Only approaching pairs (bb < 0) can touch, and then the root is at
         // least c / (-2 bb): skip pairs that cannot beat `best` without a
-        // square root. One comparison, not a test of bb first: about half
-        // the pairs approach, at random, so a branch on that alone
-        // mispredicts half the time. A receding pair gets a limit of zero,
-        // so only an overlapping one passes, and `pair_toi` turns it away.
+        // square root. A receding pair gets a limit of zero, so only an
+        // overlapping one passes, and `pair_toi` turns it away. Pairs that
+        // miss (bb^2 < a c, no real root) are skipped too: before the first
+        // hit the bound is the far-off wall, and misses were half of what
+        // passed. One branch for all of it: which pairs pass is random, so
+        // every pass costs a mispredict, and a test of bb's sign alone would
+        // mispredict half the time. It is a `max` of two differences (the
+        // sign of a difference of floats is exact, so these are `c > lim`
+        // and `bb^2 < a c` as `pair_toi` computes them): LLVM split a plain
+        // `|` of the two back into a branch on the sign of bb.
         let lim = -2.0 * bb.min(-0.0) * self.bound;
-        // And pairs that miss (no real root, as `pair_toi` finds), in the
-        // same branch: passing the test is what mispredicts, so the fewer
-        // pass the better.
-        // As one `max` (the sign of a difference of floats is exact, so
-        // these are `c > lim` and `bb * bb < a c`): LLVM split a plain `|`
-        // of the two into a branch on the sign of `bb`.
         if (c - lim).max(dv.length_squared() * c - bb * bb) > 0.0 {
             return;
         }
