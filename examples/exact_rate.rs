@@ -12,7 +12,9 @@ use std::time::Instant;
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let packing: f64 = args.first().map_or(0.25, |a| a.parse().expect("packing"));
-    let target: u64 = args.get(1).map_or(400_000, |a| a.parse().expect("collisions"));
+    let target: u64 = args
+        .get(1)
+        .map_or(400_000, |a| a.parse().expect("collisions"));
     let n = 4000;
     let mut w = lattice_world(n, packing, 1.0, 42).expect("scene");
     let mut m = Exact::default();

@@ -29,7 +29,8 @@ impl CellSlots {
         self.at.clear();
         self.at.resize(spheres, (NONE, NONE));
         self.blocks.clear();
-        self.blocks.resize(cells.next_power_of_two(), [0; BLOCK + 1]);
+        self.blocks
+            .resize(cells.next_power_of_two(), [0; BLOCK + 1]);
         self.overflow.clear();
         self.overflow.resize(cells, Vec::new());
     }

@@ -214,7 +214,8 @@ impl Cells {
     #[inline]
     pub fn new_candidates(&self, i: usize, mask: u8, out: &mut Vec<u32>) -> usize {
         let corner = self.list.cell(i) as usize - self.stencil[0];
-        self.list.gather_stencil(corner, &self.layers[mask as usize], out)
+        self.list
+            .gather_stencil(corner, &self.layers[mask as usize], out)
     }
 
     fn coords(&self, p: DVec3) -> [usize; 3] {
