@@ -40,6 +40,7 @@ impl CellSlots {
         self.at[i].0
     }
 
+    #[inline]
     fn set(&mut self, c: usize, k: usize, j: u32) {
         if k < BLOCK {
             self.blocks[c][k] = j;
@@ -54,6 +55,7 @@ impl CellSlots {
         self.at[j as usize] = (c as u32, k as u32);
     }
 
+    #[inline]
     fn get(&self, c: usize, k: usize) -> u32 {
         if k < BLOCK {
             self.blocks[c][k]
@@ -62,6 +64,7 @@ impl CellSlots {
         }
     }
 
+    #[inline]
     pub fn insert(&mut self, i: usize, c: usize) {
         let k = self.blocks[c][BLOCK] as usize;
         self.set(c, k, i as u32);
@@ -69,6 +72,7 @@ impl CellSlots {
     }
 
     /// Take sphere `i` out of its cell; the cell's last sphere fills its place.
+    #[inline]
     pub fn remove(&mut self, i: usize) {
         let (c, k) = self.at[i];
         let (c, k) = (c as usize, k as usize);
