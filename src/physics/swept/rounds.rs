@@ -3,10 +3,14 @@
 //! The spheres with an event (a pair that meets, or a wall) are grouped:
 //! pairs that meet, and pairs of such spheres whose balls for the step
 //! overlap, end up in one cluster. Each cluster runs the serial event loop
-//! on its own (`cluster::Run`), on any lane. A run that finds it may touch
-//! a sphere outside its cluster is void; so are two clusters whose balls
-//! grew into each other. Those are merged (an outsider with no event joins)
-//! and run again, until a round ends with no conflict. When rounds go on
+//! on its own (`cluster::Run`), on any lane. A run that finds it meets a
+//! sphere with no events is void. Spheres of two clusters whose balls met
+//! after all (a member's ball grew into the other's as its path turned)
+//! are only noted; once every run of a round is done, their two paths,
+//! turn by turn, say whether they really come within touching distance
+//! (with a margin far above rounding). Those that do conflict. Conflicting
+//! clusters are merged (an outsider with no event joins) and run again,
+//! until a round ends with no conflict. When rounds go on
 //! too long, or merging leaves most spheres to run again, or over 30 % of
 //! the spheres have events from the start (clusters percolate), everything
 //! runs as one cluster that takes outsiders in as it meets them: the plain
@@ -18,7 +22,7 @@
 //! and whatever runs them: clusters that cannot touch each other have no
 //! events in common, events within one are taken in the same order (ties by
 //! sphere id), and totals are summed in sphere order.
-use super::cluster::{Member, Run, Shared};
+use super::cluster::{Kink, Member, Run, Shared};
 use super::{NONE, path_ball};
 use crate::physics::broad::Grid;
 use crate::physics::exec::{Exec, Serial, next_blocks};
@@ -43,8 +47,12 @@ struct BlockOut {
     /// Finished clusters: (capped, how many of `members` are theirs).
     done: Vec<(bool, u32)>,
     members: Vec<Member>,
+    /// The members' turns (`Member::kink0` indexes here).
+    kinks: Vec<Kink>,
     /// (a member, the outsider it may touch).
     conflicts: Vec<(u32, u32)>,
+    /// Finished runs' (member, member of another cluster) to compare.
+    cross: Vec<(u32, u32)>,
 }
 
 /// How a step's events were cut, for benches and tests.
@@ -57,6 +65,10 @@ pub struct RoundStats {
     pub reruns: usize,
     /// Spheres with events.
     pub involved: usize,
+    /// Pairs in different clusters whose paths were compared, and how many
+    /// of those were found apart (no rerun needed).
+    pub compared: usize,
+    pub apart: usize,
 }
 
 /// A cluster to run: members `order[m0..m1]`, meeting pairs
@@ -95,6 +107,12 @@ pub(super) struct Rounds {
     runs: Vec<Mutex<Run>>,
     outs: Vec<Mutex<BlockOut>>,
     conflicts: Vec<(u32, u32)>,
+    /// Every finished member's turns (`Member::kink0` indexes here).
+    paths: Vec<Kink>,
+    /// (sphere, sphere of another cluster) whose paths must be compared,
+    /// from the standing runs; by slot, the round each one's run stands from.
+    cross: Vec<(u32, u32)>,
+    ran: Vec<u32>,
     /// Balls of the grown and late spheres, and a grid to find which meet.
     grown_slots: Vec<u32>,
     balls: Vec<Sphere>,
@@ -170,8 +188,9 @@ impl Rounds {
             };
             self.run_clusters(exec, &sh, absorb);
             self.collect();
-            // Grown balls are compared once the runs agree, not every round.
+            // Paths are compared once the runs agree, not every round.
             if self.conflicts.is_empty() {
+                self.check_cross(spheres, dt);
                 self.check_grown(exec, spheres, size, dt);
             }
             if self.conflicts.is_empty() {
@@ -208,6 +227,10 @@ impl Rounds {
         self.out.resize(m, None);
         self.capped.clear();
         self.capped.resize(m, false);
+        self.ran.clear();
+        self.ran.resize(m, NONE);
+        self.paths.clear();
+        self.cross.clear();
         self.stats = RoundStats {
             involved: m,
             ..RoundStats::default()
@@ -258,6 +281,7 @@ impl Rounds {
         self.dirty.push(true);
         self.out.push(None);
         self.capped.push(false);
+        self.ran.push(NONE);
         k
     }
 
@@ -377,14 +401,22 @@ impl Rounds {
                 let mut out = outs[b].lock();
                 out.done.clear();
                 out.members.clear();
+                out.kinks.clear();
                 out.conflicts.clear();
+                out.cross.clear();
                 let end = ((b + 1) * CLUSTER_BLOCK).min(todo.len());
                 for t in &todo[b * CLUSTER_BLOCK..end] {
                     let members = &order[t.m0 as usize..t.m1 as usize];
                     let cp = &pairs[t.p0 as usize..t.p1 as usize];
                     if run.run(sh, members, cp, absorb) {
                         let before = out.members.len();
-                        out.members.extend(run.members());
+                        let base = out.kinks.len() as u32;
+                        out.kinks.extend_from_slice(run.kinks());
+                        out.members.extend(run.members().map(|mut m| {
+                            m.kink0 += base;
+                            m
+                        }));
+                        out.cross.extend_from_slice(&run.cross);
                         let len = (out.members.len() - before) as u32;
                         out.done.push((run.capped, len));
                     } else {
@@ -401,6 +433,9 @@ impl Rounds {
     /// their slots; conflicts are kept for merging.
     fn collect(&mut self) {
         self.conflicts.clear();
+        let round = self.stats.rounds as u32;
+        let mut cross = std::mem::take(&mut self.cross);
+        let fresh = cross.len();
         let outs = std::mem::take(&mut self.outs);
         for block in &outs[..self.todo.len().div_ceil(CLUSTER_BLOCK)] {
             let out = block.lock();
@@ -416,8 +451,12 @@ impl Rounds {
                         NONE => self.add_slot(m.id),
                         s => s,
                     };
-                    self.out[s as usize] = Some(*m);
+                    let turns = &out.kinks[m.kink0 as usize..(m.kink0 + m.kinks) as usize];
+                    let kink0 = self.paths.len() as u32;
+                    self.paths.extend_from_slice(turns);
+                    self.out[s as usize] = Some(Member { kink0, ..*m });
                     self.capped[s as usize] = capped;
+                    self.ran[s as usize] = round;
                     let r = self.find(s);
                     if root == NONE {
                         root = r;
@@ -430,8 +469,58 @@ impl Rounds {
                 self.dirty[root as usize] = false;
             }
             self.conflicts.extend_from_slice(&out.conflicts);
+            cross.extend_from_slice(&out.cross);
         }
         self.outs = outs;
+        // What a rerun cluster noted before is replaced by what it noted now.
+        let (slot, ran) = (&self.slot, &self.ran);
+        let mut k = 0;
+        cross.retain(|&(a, _)| {
+            k += 1;
+            k > fresh || ran[slot[a as usize] as usize] != round
+        });
+        self.cross = cross;
+    }
+
+    /// Pairs of spheres in different clusters whose balls met during a run
+    /// conflict if their paths really come within touching distance.
+    fn check_cross(&mut self, spheres: &[Sphere], dt: f64) {
+        for k in 0..self.cross.len() {
+            let (a, b) = self.cross[k];
+            let (sa, sb) = (self.slot[a as usize], self.slot[b as usize]);
+            if self.find(sa) != self.find(sb) {
+                self.compare(sa, sb, spheres, dt);
+            }
+        }
+    }
+
+    /// Slots `a` and `b` (different clusters) conflict if their paths meet.
+    fn compare(&mut self, a: u32, b: u32, spheres: &[Sphere], dt: f64) {
+        self.stats.compared += 1;
+        if self.paths_meet(a, b, spheres, dt) {
+            self.conflicts
+                .push((self.ids[a as usize], self.ids[b as usize]));
+        } else {
+            self.stats.apart += 1;
+        }
+    }
+
+    /// Whether the spheres of slots `a` and `b`, on the paths their last
+    /// runs took, come within touching distance during the step. A capped
+    /// run's path is not fully known: it meets everyone.
+    fn paths_meet(&self, a: u32, b: u32, spheres: &[Sphere], dt: f64) -> bool {
+        let (a, b) = (a as usize, b as usize);
+        if self.capped[a] || self.capped[b] {
+            return true;
+        }
+        let path = |s: usize| {
+            let m = self.out[s].expect("a finished run's member");
+            let start = spheres[m.id as usize];
+            let turns = &self.paths[m.kink0 as usize..(m.kink0 + m.kinks) as usize];
+            (start, turns)
+        };
+        let ((sa, ta), (sb, tb)) = (path(a), path(b));
+        paths_meet(&sa, ta, &sb, tb, dt)
     }
 
     /// A finished cluster whose member's ball grew was checked against the
@@ -483,8 +572,7 @@ impl Rounds {
             .pairs(small(exec, self.balls.len()), &apart, &mut pairs);
         for &(a, b) in &pairs {
             let (sa, sb) = (self.grown_slots[a as usize], self.grown_slots[b as usize]);
-            self.conflicts
-                .push((self.ids[sa as usize], self.ids[sb as usize]));
+            self.compare(sa, sb, spheres, dt);
         }
         self.overlap_pairs = pairs;
     }
@@ -545,6 +633,54 @@ impl Rounds {
     }
 }
 
+/// Relative margin on the touching distance when comparing two paths: far
+/// above the rounding of positions (about 1e-16 of the box), so a pair the
+/// serial loop would see touch is never passed as apart.
+const PATH_MARGIN: f64 = 1e-8;
+
+/// Whether two spheres, from `a` and `b` at the start of the step and
+/// turning as `ta` and `tb` say (time order), come within the sum of their
+/// radii (widened by [`PATH_MARGIN`]) at one moment of `0..=dt`: on each
+/// stretch where both fly straight, the closest approach of the two lines.
+fn paths_meet(a: &Sphere, ta: &[Kink], b: &Sphere, tb: &[Kink], dt: f64) -> bool {
+    let sigma = (a.radius + b.radius) * (1.0 + PATH_MARGIN);
+    let start = |s: &Sphere| Kink {
+        t: 0.0,
+        pos: s.pos,
+        vel: s.vel,
+    };
+    let (mut ka, mut kb) = (start(a), start(b));
+    let (mut ia, mut ib) = (0, 0);
+    let mut t0 = 0.0;
+    loop {
+        let next = |turns: &[Kink], i: usize| turns.get(i).map_or(dt, |k| k.t.min(dt));
+        let t1 = next(ta, ia).min(next(tb, ib));
+        let dp = (ka.pos + ka.vel * (t0 - ka.t)) - (kb.pos + kb.vel * (t0 - kb.t));
+        let dv = ka.vel - kb.vel;
+        let vv = dv.length_squared();
+        let s = if vv > 0.0 {
+            (-dp.dot(dv) / vv).clamp(0.0, t1 - t0)
+        } else {
+            0.0
+        };
+        if (dp + dv * s).length_squared() <= sigma * sigma {
+            return true;
+        }
+        if t1 >= dt {
+            return false;
+        }
+        while ia < ta.len() && ta[ia].t <= t1 {
+            ka = ta[ia];
+            ia += 1;
+        }
+        while ib < tb.len() && tb[ib].t <= t1 {
+            kb = tb[ib];
+            ib += 1;
+        }
+        t0 = t1;
+    }
+}
+
 /// Groups `items` by key in `0..keys`, keeping their order within a key:
 /// `out[starts[k]..starts[k + 1]]` are the items of key `k`.
 fn group<T: Copy + Default>(
@@ -579,4 +715,63 @@ fn group<T: Copy + Default>(
 /// handing to other threads (each hand-off costs tens of microseconds).
 fn small(exec: &dyn Exec, n: usize) -> &dyn Exec {
     if n < LANES_MIN_BALLS { &Serial } else { exec }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sphere(pos: [f64; 3], vel: [f64; 3]) -> Sphere {
+        Sphere {
+            pos: DVec3::from(pos),
+            vel: DVec3::from(vel),
+            radius: 0.1,
+            mass: 1.0,
+        }
+    }
+
+    fn turn(t: f64, pos: [f64; 3], vel: [f64; 3]) -> Kink {
+        Kink {
+            t,
+            pos: DVec3::from(pos),
+            vel: DVec3::from(vel),
+        }
+    }
+
+    #[test]
+    fn crossing_lines_meet_only_at_the_same_time() {
+        // Both pass through the origin: at t = 1 together, or a second apart.
+        let a = sphere([-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
+        let together = sphere([0.0, -1.0, 0.0], [0.0, 1.0, 0.0]);
+        let late = sphere([0.0, -2.0, 0.0], [0.0, 1.0, 0.0]);
+        assert!(paths_meet(&a, &[], &together, &[], 2.0));
+        assert!(!paths_meet(&a, &[], &late, &[], 2.0));
+        // Closest approach after the step ends does not count.
+        assert!(!paths_meet(&a, &[], &together, &[], 0.5));
+        // Just outside and just inside touching distance (0.2).
+        let by = |gap: f64| sphere([0.0, gap, 0.0], [1.0, 0.0, 0.0]);
+        let still = sphere([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
+        assert!(!paths_meet(&still, &[], &by(0.2 * (1.0 + 1e-6)), &[], 1.0));
+        assert!(paths_meet(&still, &[], &by(0.2 * (1.0 - 1e-6)), &[], 1.0));
+    }
+
+    #[test]
+    fn a_turn_decides_whether_paths_meet() {
+        // `b` waits at (0, 1, 0). `a` heads along x; turned up at t = 1 (at
+        // the origin) it touches `b` at t = 1.8; turned down it never does,
+        // and straight it passes 1 away.
+        let a = sphere([-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
+        let b = sphere([0.0, 1.0, 0.0], [0.0, 0.0, 0.0]);
+        let up = [turn(1.0, [0.0, 0.0, 0.0], [0.0, 1.0, 0.0])];
+        let down = [turn(1.0, [0.0, 0.0, 0.0], [0.0, -1.0, 0.0])];
+        assert!(!paths_meet(&a, &[], &b, &[], 3.0));
+        assert!(paths_meet(&a, &up, &b, &[], 3.0));
+        assert!(paths_meet(&b, &[], &a, &up, 3.0), "either order");
+        assert!(!paths_meet(&a, &down, &b, &[], 3.0));
+        // The meeting at t = 1.8 lies past a step of 1.5.
+        assert!(!paths_meet(&a, &up, &b, &[], 1.5));
+        // Both turn: `b` runs off along +y at t = 0.5 and stays ahead.
+        let away = [turn(0.5, [0.0, 1.0, 0.0], [0.0, 2.0, 0.0])];
+        assert!(!paths_meet(&a, &up, &b, &away, 3.0));
+    }
 }
