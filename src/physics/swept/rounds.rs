@@ -30,7 +30,7 @@ use crate::physics::sphere::Sphere;
 use crate::physics::world::Counters;
 use glam::DVec3;
 use parking_lot::Mutex;
-use std::sync::atomic::AtomicUsize;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Fewer grown balls than this are compared on one lane.
 const LANES_MIN_BALLS: usize = 8192;
@@ -173,12 +173,12 @@ impl Rounds {
                 self.stats.reruns += self.todo.len();
             }
             // A few events are not worth waking other threads for.
-            let exec: &dyn Exec = if absorb || self.order.len() < LANES_MIN_MEMBERS {
+            let lanes: &dyn Exec = if absorb || self.order.len() < LANES_MIN_MEMBERS {
                 &Serial
             } else {
                 exec
             };
-            self.reserve(exec);
+            self.reserve(lanes);
             let sh = Shared {
                 spheres,
                 grid,
@@ -186,11 +186,14 @@ impl Rounds {
                 size,
                 dt,
             };
-            self.run_clusters(exec, &sh, absorb);
+            self.run_clusters(lanes, &sh, absorb);
             self.collect();
-            // Paths are compared once the runs agree, not every round.
+            // Paths are compared once the runs agree, not every round; the
+            // grown balls (a grid over all of them) once the noted pairs agree.
             if self.conflicts.is_empty() {
                 self.check_cross(spheres, dt);
+            }
+            if self.conflicts.is_empty() {
                 self.check_grown(exec, spheres, size, dt);
             }
             if self.conflicts.is_empty() {
@@ -497,7 +500,7 @@ impl Rounds {
     /// Slots `a` and `b` (different clusters) conflict if their paths meet.
     fn compare(&mut self, a: u32, b: u32, spheres: &[Sphere], dt: f64) {
         self.stats.compared += 1;
-        if self.paths_meet(a, b, spheres, dt) {
+        if self.view(spheres, dt).meet(a as usize, b as usize) {
             self.conflicts
                 .push((self.ids[a as usize], self.ids[b as usize]));
         } else {
@@ -505,22 +508,14 @@ impl Rounds {
         }
     }
 
-    /// Whether the spheres of slots `a` and `b`, on the paths their last
-    /// runs took, come within touching distance during the step. A capped
-    /// run's path is not fully known: it meets everyone.
-    fn paths_meet(&self, a: u32, b: u32, spheres: &[Sphere], dt: f64) -> bool {
-        let (a, b) = (a as usize, b as usize);
-        if self.capped[a] || self.capped[b] {
-            return true;
+    fn view<'a>(&'a self, spheres: &'a [Sphere], dt: f64) -> Paths<'a> {
+        Paths {
+            out: &self.out,
+            capped: &self.capped,
+            turns: &self.paths,
+            spheres,
+            dt,
         }
-        let path = |s: usize| {
-            let m = self.out[s].expect("a finished run's member");
-            let start = spheres[m.id as usize];
-            let turns = &self.paths[m.kink0 as usize..(m.kink0 + m.kinks) as usize];
-            (start, turns)
-        };
-        let ((sa, ta), (sb, tb)) = (path(a), path(b));
-        paths_meet(&sa, ta, &sb, tb, dt)
     }
 
     /// A finished cluster whose member's ball grew was checked against the
@@ -563,16 +558,33 @@ impl Rounds {
         );
         let mut pairs = std::mem::take(&mut self.overlap_pairs);
         let (out, slots, cluster_of) = (&self.out, &self.grown_slots, &self.cluster_of);
+        let paths = Paths {
+            out,
+            capped: &self.capped,
+            turns: &self.paths,
+            spheres,
+            dt,
+        };
+        let compared = AtomicUsize::new(0);
         let grew = |k: u32| out[slots[k as usize] as usize].is_some_and(|m| m.grew);
-        let apart = |a: u32, b: u32| {
+        // The paths are compared in the pair search, on its lanes.
+        let meet = |a: u32, b: u32| {
             let (sa, sb) = (slots[a as usize] as usize, slots[b as usize] as usize);
-            (grew(a) || grew(b)) && cluster_of[sa] != cluster_of[sb]
+            if !(grew(a) || grew(b)) || cluster_of[sa] == cluster_of[sb] {
+                return false;
+            }
+            compared.fetch_add(1, Ordering::Relaxed);
+            paths.meet(sa, sb)
         };
         self.overlap
-            .pairs(small(exec, self.balls.len()), &apart, &mut pairs);
+            .pairs(small(exec, self.balls.len()), &meet, &mut pairs);
+        let compared = compared.into_inner();
+        self.stats.compared += compared;
+        self.stats.apart += compared - pairs.len();
         for &(a, b) in &pairs {
             let (sa, sb) = (self.grown_slots[a as usize], self.grown_slots[b as usize]);
-            self.compare(sa, sb, spheres, dt);
+            self.conflicts
+                .push((self.ids[sa as usize], self.ids[sb as usize]));
         }
         self.overlap_pairs = pairs;
     }
@@ -630,6 +642,33 @@ impl Rounds {
         if any_capped {
             counters.capped_steps += 1;
         }
+    }
+}
+
+/// The paths the finished runs took, by slot.
+struct Paths<'a> {
+    out: &'a [Option<Member>],
+    capped: &'a [bool],
+    turns: &'a [Kink],
+    spheres: &'a [Sphere],
+    dt: f64,
+}
+
+impl Paths<'_> {
+    /// Whether the spheres of slots `a` and `b` come within touching
+    /// distance during the step. A capped run's path is not fully known: it
+    /// meets everyone.
+    fn meet(&self, a: usize, b: usize) -> bool {
+        if self.capped[a] || self.capped[b] {
+            return true;
+        }
+        let path = |s: usize| {
+            let m = self.out[s].expect("a finished run's member");
+            let turns = &self.turns[m.kink0 as usize..(m.kink0 + m.kinks) as usize];
+            (&self.spheres[m.id as usize], turns)
+        };
+        let ((sa, ta), (sb, tb)) = (path(a), path(b));
+        paths_meet(sa, ta, sb, tb, self.dt)
     }
 }
 
