@@ -27,7 +27,6 @@ use super::{NONE, path_ball};
 use crate::physics::broad::Grid;
 use crate::physics::exec::{Exec, Serial, next_blocks};
 use crate::physics::sphere::Sphere;
-use crate::physics::world::Counters;
 use glam::DVec3;
 use parking_lot::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -125,28 +124,36 @@ pub(super) struct Rounds {
 }
 
 impl Rounds {
-    /// Whether sphere `i` had an event in the last `run`.
+    /// Sphere `i`'s result of the last `run` (and whether its run hit the
+    /// event cap), if it had events.
     #[inline]
-    pub fn involved(&self, i: usize) -> bool {
-        self.slot[i] != NONE
+    pub fn result(&self, i: usize) -> Option<(&Member, bool)> {
+        match self.slot[i] {
+            NONE => None,
+            s => Some((
+                self.out[s as usize]
+                    .as_ref()
+                    .expect("every involved sphere finished"),
+                self.capped[s as usize],
+            )),
+        }
     }
 
     /// Runs the events of a step: `meets` are the pairs whose straight paths
     /// meet within `dt`, `near` pairs whose balls overlap but do not meet,
-    /// `hits` the spheres that reach a wall. Leaves every involved sphere
-    /// at the end of the step in `spheres` and adds to `counters`.
+    /// `hits` the spheres that reach a wall. Each involved sphere's end of
+    /// the step is then its [`Rounds::result`]; `spheres` is not changed.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &mut self,
         exec: &dyn Exec,
-        spheres: &mut [Sphere],
+        spheres: &[Sphere],
         grid: &Grid,
         size: f64,
         dt: f64,
         meets: &[(u32, u32)],
         near: &[(u32, u32)],
         hits: &[u32],
-        counters: &mut Counters,
     ) {
         let serial = self.start(spheres.len(), meets, near, hits);
         let mut round = 0;
@@ -202,7 +209,6 @@ impl Rounds {
             self.merge_conflicts();
             round += 1;
         }
-        self.write_back(spheres, counters);
     }
 
     /// Slots for the spheres with events and their first clusters; true
@@ -608,40 +614,6 @@ impl Rounds {
             self.union(self.slot[a as usize], sj);
         }
         self.conflicts = conflicts;
-    }
-
-    fn write_back(&mut self, spheres: &mut [Sphere], counters: &mut Counters) {
-        let mut any_capped = false;
-        for (s, m) in self.out.iter().enumerate() {
-            let m = m.expect("every involved sphere finished");
-            spheres[m.id as usize] = m.sphere;
-            counters.sphere_collisions += m.pair_hits as u64;
-            counters.wall_collisions += m.wall_hits as u64;
-            any_capped |= self.capped[s];
-        }
-        // The wall momentum is summed in sphere order, however the rounds
-        // went: the first slots are in id order, the late ones are merged in.
-        let mut late: Vec<(u32, f64)> = self.out[self.first_late..]
-            .iter()
-            .map(|m| m.map(|m| (m.id, m.wall_momentum)).expect("finished"))
-            .collect();
-        late.sort_unstable_by_key(|&(id, _)| id);
-        let mut late = late.into_iter().peekable();
-        for m in self.out[..self.first_late].iter().flatten() {
-            while let Some(&(id, p)) = late.peek()
-                && id < m.id
-            {
-                counters.wall_momentum += p;
-                late.next();
-            }
-            counters.wall_momentum += m.wall_momentum;
-        }
-        for (_, p) in late {
-            counters.wall_momentum += p;
-        }
-        if any_capped {
-            counters.capped_steps += 1;
-        }
     }
 }
 
