@@ -89,6 +89,15 @@ pub(super) struct Rounds {
     /// Slots from here on were added after the first round.
     first_late: usize,
     parent: Vec<u32>,
+    /// Each cluster's slots as a cycle (`next` of the last is the first),
+    /// so a merged cluster's members are found without scanning everyone.
+    next: Vec<u32>,
+    /// Roots marked dirty since the last partition (some merged since).
+    dirty_roots: Vec<u32>,
+    /// By slot: where its meeting pairs (as the pair's first sphere) start
+    /// in `meets_of`, indices into the step's `meets`.
+    meet_start: Vec<u32>,
+    meets_of: Vec<u32>,
     /// By root slot: the cluster must run (again).
     dirty: Vec<bool>,
     /// By slot: the member's result from its cluster's last finished run.
@@ -97,7 +106,6 @@ pub(super) struct Rounds {
     /// Slot → root slot, fixed during a round (the cluster's name).
     cluster_of: Vec<u32>,
     starts: Vec<u32>,
-    keys: Vec<u64>,
     order: Vec<u32>,
     pair_starts: Vec<u32>,
     pairs: Vec<(u32, u32)>,
@@ -219,17 +227,28 @@ impl Rounds {
         }
         self.slot.resize(n, NONE);
         self.ids.clear();
-        self.ids.extend(meets.iter().flat_map(|&(i, j)| [i, j]));
-        self.ids.extend_from_slice(hits);
-        self.ids.sort_unstable();
-        self.ids.dedup();
-        for (k, &i) in self.ids.iter().enumerate() {
-            self.slot[i as usize] = k as u32;
+        // Marked, then read off in order: one pass over the spheres costs
+        // less than sorting the tens of thousands of ends of the pairs.
+        for &(i, j) in meets {
+            self.slot[i as usize] = 0;
+            self.slot[j as usize] = 0;
+        }
+        for &i in hits {
+            self.slot[i as usize] = 0;
+        }
+        for (i, slot) in self.slot.iter_mut().enumerate() {
+            if *slot != NONE {
+                *slot = self.ids.len() as u32;
+                self.ids.push(i as u32);
+            }
         }
         let m = self.ids.len();
         self.first_late = m;
         self.parent.clear();
         self.parent.extend(0..m as u32);
+        self.next.clear();
+        self.next.extend(0..m as u32);
+        self.dirty_roots.clear();
         self.dirty.clear();
         self.dirty.resize(m, true);
         self.out.clear();
@@ -250,7 +269,7 @@ impl Rounds {
         let serial = self.serial_only || 10 * m > 3 * n;
         if serial {
             // One cluster: every slot's parent is slot 0.
-            self.parent.fill(0);
+            self.merge_all();
             return true;
         }
         for &(i, j) in meets {
@@ -276,10 +295,21 @@ impl Rounds {
 
     /// Joins two slots' clusters; the joined cluster must run again.
     fn union(&mut self, a: u32, b: u32) {
+        let lo = self.link(a, b);
+        self.dirty[lo as usize] = true;
+        self.dirty_roots.push(lo);
+    }
+
+    /// Joins two slots' clusters under the lower root, which it returns.
+    fn link(&mut self, a: u32, b: u32) -> u32 {
         let (ra, rb) = (self.find(a), self.find(b));
         let (lo, hi) = (ra.min(rb), ra.max(rb));
-        self.parent[hi as usize] = lo;
-        self.dirty[lo as usize] = true;
+        if lo != hi {
+            self.parent[hi as usize] = lo;
+            // Splicing two cycles is swapping one successor of each.
+            self.next.swap(lo as usize, hi as usize);
+        }
+        lo
     }
 
     fn add_slot(&mut self, id: u32) -> u32 {
@@ -287,7 +317,9 @@ impl Rounds {
         self.slot[id as usize] = k;
         self.ids.push(id);
         self.parent.push(k);
+        self.next.push(k);
         self.dirty.push(true);
+        self.dirty_roots.push(k);
         self.out.push(None);
         self.capped.push(false);
         self.ran.push(NONE);
@@ -298,90 +330,111 @@ impl Rounds {
     /// all the spheres with events, which no outsider with events can
     /// touch, so it finishes in one run.
     fn merge_all(&mut self) {
-        for s in 0..self.ids.len() {
+        let m = self.ids.len();
+        for s in 0..m {
             self.parent[s] = 0;
+            self.next[s] = ((s + 1) % m) as u32;
         }
-        if !self.ids.is_empty() {
+        if m > 0 {
             self.dirty[0] = true;
+            self.dirty_roots.push(0);
         }
     }
 
     /// This round's clusters (named by root slot) and the ones that must
-    /// run, with their members and meeting pairs, grouped by counting sort.
+    /// run, with their members and meeting pairs: everyone in the first
+    /// round, grouped by counting sort; later, only the clusters marked
+    /// dirty, found through their cycles.
     fn partition(&mut self, meets: &[(u32, u32)]) {
+        self.todo.clear();
+        if self.stats.rounds == 0 {
+            self.partition_all(meets);
+        } else {
+            self.partition_dirty(meets);
+        }
+    }
+
+    fn partition_all(&mut self, meets: &[(u32, u32)]) {
         let m = self.ids.len();
         self.cluster_of.resize(m, NONE);
         for s in 0..m as u32 {
             let r = self.find(s);
             self.cluster_of[s as usize] = r;
         }
-        let (cluster_of, dirty, slot, ids) = (&self.cluster_of, &self.dirty, &self.slot, &self.ids);
-        self.todo.clear();
-        if self.stats.rounds == 0 {
-            // Everyone runs: group by counting sort.
-            let member_roots = (0..m).map(|s| (cluster_of[s], ids[s]));
-            group(&mut self.starts, &mut self.order, m, member_roots);
-            let pair_roots = meets
-                .iter()
-                .map(|&(i, j)| (cluster_of[slot[i as usize] as usize], (i, j)));
-            group(&mut self.pair_starts, &mut self.pairs, m, pair_roots);
-            for r in 0..m {
-                let (m0, m1) = (self.starts[r], self.starts[r + 1]);
-                if m1 > m0 {
-                    self.todo.push(Todo {
-                        m0,
-                        m1,
-                        p0: self.pair_starts[r],
-                        p1: self.pair_starts[r + 1],
-                    });
+        self.dirty_roots.clear();
+        let (cluster_of, slot, ids) = (&self.cluster_of, &self.slot, &self.ids);
+        let member_roots = (0..m).map(|s| (cluster_of[s], ids[s]));
+        group(&mut self.starts, &mut self.order, m, member_roots);
+        let pair_roots = meets
+            .iter()
+            .map(|&(i, j)| (cluster_of[slot[i as usize] as usize], (i, j)));
+        group(&mut self.pair_starts, &mut self.pairs, m, pair_roots);
+        for r in 0..m {
+            let (m0, m1) = (self.starts[r], self.starts[r + 1]);
+            if m1 > m0 {
+                self.todo.push(Todo {
+                    m0,
+                    m1,
+                    p0: self.pair_starts[r],
+                    p1: self.pair_starts[r + 1],
+                });
+            }
+        }
+        // Each slot's meeting pairs, for the later rounds.
+        let by_slot = meets
+            .iter()
+            .enumerate()
+            .map(|(p, &(i, _))| (slot[i as usize], p as u32));
+        group(&mut self.meet_start, &mut self.meets_of, m, by_slot);
+    }
+
+    /// The clusters marked dirty since the last partition, each with its
+    /// members in sphere order and its meeting pairs in detection order
+    /// (as the first round has them), in order of their roots.
+    fn partition_dirty(&mut self, meets: &[(u32, u32)]) {
+        let mut roots = std::mem::take(&mut self.dirty_roots);
+        for r in &mut roots {
+            *r = self.find(*r);
+        }
+        roots.sort_unstable();
+        roots.dedup();
+        roots.retain(|&r| self.dirty[r as usize]);
+        self.cluster_of.resize(self.ids.len(), NONE);
+        self.order.clear();
+        self.pairs.clear();
+        let mut found: Vec<u32> = Vec::new();
+        let mut ps: Vec<u32> = Vec::new();
+        for &root in &roots {
+            found.clear();
+            ps.clear();
+            let mut s = root;
+            loop {
+                found.push(self.ids[s as usize]);
+                self.cluster_of[s as usize] = root;
+                // Slots added after the first round own no meeting pairs.
+                if (s as usize) < self.first_late {
+                    let (a, b) = (self.meet_start[s as usize], self.meet_start[s as usize + 1]);
+                    ps.extend_from_slice(&self.meets_of[a as usize..b as usize]);
+                }
+                s = self.next[s as usize];
+                if s == root {
+                    break;
                 }
             }
-            return;
-        }
-        // Later rounds run a few merged clusters: sort just those.
-        self.keys.clear();
-        self.keys.extend(
-            (0..m)
-                .filter(|&s| dirty[cluster_of[s] as usize])
-                .map(|s| (cluster_of[s] as u64) << 32 | ids[s] as u64),
-        );
-        self.keys.sort_unstable();
-        self.order.clear();
-        self.order.extend(self.keys.iter().map(|&k| k as u32));
-        let mut k = 0;
-        while k < self.keys.len() {
-            let root = self.keys[k] >> 32;
-            let m0 = k;
-            while k < self.keys.len() && self.keys[k] >> 32 == root {
-                k += 1;
-            }
+            found.sort_unstable();
+            ps.sort_unstable();
+            let (m0, p0) = (self.order.len() as u32, self.pairs.len() as u32);
+            self.order.extend_from_slice(&found);
+            self.pairs.extend(ps.iter().map(|&p| meets[p as usize]));
             self.todo.push(Todo {
-                m0: m0 as u32,
-                m1: k as u32,
-                p0: 0,
-                p1: 0,
+                m0,
+                m1: self.order.len() as u32,
+                p0,
+                p1: self.pairs.len() as u32,
             });
         }
-        self.keys.clear();
-        self.keys
-            .extend(meets.iter().enumerate().filter_map(|(p, &(i, _))| {
-                let r = cluster_of[slot[i as usize] as usize];
-                dirty[r as usize].then_some((r as u64) << 32 | p as u64)
-            }));
-        self.keys.sort_unstable();
-        self.pairs.clear();
-        self.pairs
-            .extend(self.keys.iter().map(|&k| meets[k as u32 as usize]));
-        // Both are sorted by root: walk them together.
-        let mut p = 0;
-        for t in &mut self.todo {
-            let root = cluster_of[slot[self.order[t.m0 as usize] as usize] as usize] as u64;
-            t.p0 = p as u32;
-            while p < self.keys.len() && self.keys[p] >> 32 == root {
-                p += 1;
-            }
-            t.p1 = p as u32;
-        }
+        roots.clear();
+        self.dirty_roots = roots;
     }
 
     /// Scratch for `run_clusters` on `exec`.
@@ -466,14 +519,11 @@ impl Rounds {
                     self.out[s as usize] = Some(Member { kink0, ..*m });
                     self.capped[s as usize] = capped;
                     self.ran[s as usize] = round;
-                    let r = self.find(s);
-                    if root == NONE {
-                        root = r;
-                    } else if r != root {
-                        let (lo, hi) = (r.min(root), r.max(root));
-                        self.parent[hi as usize] = lo;
-                        root = lo;
-                    }
+                    root = if root == NONE {
+                        self.find(s)
+                    } else {
+                        self.link(root, s)
+                    };
                 }
                 self.dirty[root as usize] = false;
             }
