@@ -2,9 +2,9 @@
 //! sphere-steps per second: a small target for profilers (callgrind counts
 //! the instructions of a step as the difference of two step counts).
 //!
-//! `cargo run --release --example step -- swept 10000 0.005 200`
+//! `cargo run --release --example step -- swept 10000 0.005 200 [speed] [threads|sK]`
 use ballpit::physics::sphere::volume;
-use ballpit::physics::{ModelKind, Serial};
+use ballpit::physics::{Exec, ModelKind, Serial};
 use ballpit::scene::{SceneSpec, build_world};
 use std::time::Instant;
 
@@ -25,15 +25,25 @@ fn main() {
         ..Default::default()
     })
     .expect("scene");
-    let threads: usize = arg(5, "1").parse().expect("threads");
-    let pool = (threads > 1).then(|| ballpit::engine::PoolExec::new(threads).expect("pool"));
-    let exec: &dyn ballpit::physics::Exec = match &pool {
+    // `s2`: two lanes taken one after the other on this thread, for
+    // counting what a step hands its lanes (`*for_each_lane*` in callgrind)
+    // against what it runs alone.
+    let lanes_arg = arg(5, "1");
+    let (threads, sequential) = match lanes_arg.strip_prefix('s') {
+        Some(k) => (k.parse().expect("lanes"), true),
+        None => (lanes_arg.parse().expect("threads"), false),
+    };
+    let pool = (threads > 1 && !sequential)
+        .then(|| ballpit::engine::PoolExec::new(threads).expect("pool"));
+    let one_by_one = SequentialLanes(threads);
+    let exec: &dyn Exec = match &pool {
         Some(p) => p,
+        None if sequential => &one_by_one,
         None => &Serial,
     };
     let mut m = model.build();
     let start = Instant::now();
-    m.advance(&mut world, 1.0 / 60.0, steps, exec);
+    exec.host(&mut || m.advance(&mut world, 1.0 / 60.0, steps, exec));
     let secs = start.elapsed().as_secs_f64();
     println!(
         "{model} n={n} packing={phi} steps={steps} threads={threads}: {:.2} M sphere-steps/s, {} contacts, {} wall hits",
@@ -41,4 +51,21 @@ fn main() {
         world.counters.sphere_collisions,
         world.counters.wall_collisions
     );
+}
+
+/// Lanes run one after the other on the calling thread.
+struct SequentialLanes(usize);
+
+impl Exec for SequentialLanes {
+    fn lanes(&self) -> usize {
+        self.0
+    }
+    #[inline(never)]
+    fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
+        (0..self.0).for_each(f)
+    }
+    fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {
+        a();
+        b();
+    }
 }

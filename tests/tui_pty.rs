@@ -296,7 +296,7 @@ fn a_panic_in_another_thread_restores_the_terminal_then_prints_and_fails() {
     let mut reader = pty.master.try_clone_reader().unwrap();
     let raw = Arc::new(Mutex::new(Vec::new()));
     let r = raw.clone();
-    thread::spawn(move || {
+    let drain = thread::spawn(move || {
         let mut buf = [0u8; 65536];
         while let Ok(n) = reader.read(&mut buf) {
             if n == 0 {
@@ -314,7 +314,12 @@ fn a_panic_in_another_thread_restores_the_terminal_then_prints_and_fails() {
         thread::sleep(Duration::from_millis(20));
     };
     assert!(!status.success());
-    thread::sleep(Duration::from_millis(200));
+    // Everything the app wrote before it ended, however loaded the machine:
+    // the reader stops at the end of the terminal's output.
+    let end = Instant::now() + Duration::from_secs(5);
+    while !drain.is_finished() && Instant::now() < end {
+        thread::sleep(Duration::from_millis(20));
+    }
     let out = String::from_utf8_lossy(&raw.lock().unwrap()).to_string();
     let left = out.rfind("\x1b[?1049l").expect("left the alternate screen");
     let msg = out

@@ -39,8 +39,14 @@ impl Frame {
         }
     }
 
-    /// Step the world `tick` times and fill the back snapshot.
+    /// Step the world `tick` times and fill the back snapshot, on a thread
+    /// of the frame's executor.
     pub fn run(&mut self) {
+        let exec = self.exec.clone();
+        exec.host(&mut || self.run_here());
+    }
+
+    fn run_here(&mut self) {
         let steps = u64::from(self.settings.tick);
         let t0 = Instant::now();
         self.model

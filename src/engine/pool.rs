@@ -52,6 +52,14 @@ impl Exec for PoolExec {
     fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {
         self.pool.join(a, b);
     }
+
+    /// The frame runs on `pool-0`..: a broadcast from inside the pool runs
+    /// one lane on the caller, and the other lanes, idle only since the
+    /// last section, are usually still spinning rather than asleep. From
+    /// outside, each section paid two sleeping-thread wake-ups.
+    fn host(&self, job: &mut (dyn FnMut() + Send)) {
+        self.pool.install(job);
+    }
 }
 
 /// Names of the `split` threads, by the work they take.

@@ -22,6 +22,9 @@ const CROSS_BLOCK: usize = 64;
 const LANES_MIN_SPHERES: usize = 16_384;
 /// Spheres per parallel block while binning.
 const BUILD_BLOCK: usize = 4096;
+/// The first level's cell comes from every this-many-th reach.
+const SAMPLE_STRIDE: usize = 8;
+const _: () = assert!(BUILD_BLOCK.is_multiple_of(SAMPLE_STRIDE));
 
 /// A sphere's ball for the step: it stays within `reach` of `pos`.
 #[derive(Clone, Copy, Debug, Default)]
@@ -80,9 +83,10 @@ pub struct Grid {
     /// Spheres not yet placed in a level: (ball, id).
     rest: Vec<(Ball, u32)>,
     scratch: Vec<f64>,
-    /// Per block of spheres: the widest reach, and the balls too wide for
-    /// the first level (found in parallel, joined in block order).
-    block_max: Vec<Mutex<f64>>,
+    /// Per block of spheres: the widest reach, every [`SAMPLE_STRIDE`]-th
+    /// reach, and the balls too wide for the first level (found in
+    /// parallel, joined in block order).
+    block_max: Vec<Mutex<(f64, Vec<f64>)>>,
     wide: Vec<Mutex<Vec<(Ball, u32)>>>,
     slots: Vec<Mutex<Vec<Pair>>>,
 }
@@ -109,6 +113,11 @@ fn cell_for(
 ) -> f64 {
     scratch.clear();
     scratch.extend(reaches.step_by(stride));
+    cell_of_sample(scratch, max)
+}
+
+/// [`cell_for`] of reaches already sampled into `scratch` (reordered).
+fn cell_of_sample(scratch: &mut [f64], max: f64) -> f64 {
     if scratch.is_empty() {
         return 2.0 * max;
     }
@@ -443,7 +452,7 @@ impl Grid {
         self.top.clear();
         self.staged.resize(n, Staged::default());
         let blocks = n.div_ceil(BUILD_BLOCK);
-        self.block_max.resize_with(blocks, || Mutex::new(0.0));
+        self.block_max.resize_with(blocks, Default::default);
         let block_max = &self.block_max;
         for_each_chunk(exec, &mut self.staged, BUILD_BLOCK, &|b, chunk| {
             let mut max: f64 = 0.0;
@@ -454,7 +463,11 @@ impl Grid {
                     max = reach;
                 }
             }
-            *block_max[b].lock() = max;
+            let mut out = block_max[b].lock();
+            out.0 = max;
+            out.1.clear();
+            out.1
+                .extend(chunk.iter().step_by(SAMPLE_STRIDE).map(|s| s.ball.reach));
         });
         let mut depth = 0;
         if n > ALL_PAIRS_MAX {
@@ -464,13 +477,12 @@ impl Grid {
             }
             let max = self.block_max[..blocks]
                 .iter()
-                .fold(0.0f64, |m, b| m.max(*b.lock()));
-            let want = cell_for(
-                self.staged.iter().map(|s| s.ball.reach),
-                max,
-                8,
-                &mut self.scratch,
-            );
+                .fold(0.0f64, |m, b| m.max(b.lock().0));
+            self.scratch.clear();
+            for b in &self.block_max[..blocks] {
+                self.scratch.extend_from_slice(&b.lock().1);
+            }
+            let want = cell_of_sample(&mut self.scratch, max);
             let level = &mut self.levels[0];
             level.shape(size, want, n, true);
             self.wide.resize_with(blocks, Default::default);

@@ -18,6 +18,12 @@ pub trait Exec: Sync {
     fn functional(&self) -> bool {
         false
     }
+    /// Run `job` on one of the executor's own threads, so that the parallel
+    /// sections inside it start from a lane that is already awake instead
+    /// of waking every lane from outside each time. Default: right here.
+    fn host(&self, job: &mut (dyn FnMut() + Send)) {
+        job()
+    }
 }
 
 /// Everything on the calling thread.

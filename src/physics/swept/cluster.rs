@@ -1,9 +1,12 @@
 //! One cluster's contact events within a step, on private copies of its
 //! spheres: the serial event loop of `swept` (time order, lazy clocks,
 //! collision counters, rescans on every velocity change), run for a set of
-//! spheres that should not touch anyone outside it. When a rescan finds that
-//! they might after all, the run stops and names the outsider, so the
-//! caller can merge and run again (see `rounds`).
+//! spheres that should not touch anyone outside it. When a rescan finds an
+//! outsider with no events of its own that it meets, the run is void and
+//! names it, so the caller can merge and run again; a member of another
+//! cluster, whose path is not known here, is only noted, and the caller
+//! checks the two paths once both runs are done (see `rounds`). Each
+//! member's path is kept as the turns it took.
 use super::{NONE, REACH_SLACK, path_ball};
 use crate::physics::broad::Grid;
 use crate::physics::contact::{pair_toi, reflect_walls, resolve_pair, wall_toi};
@@ -65,6 +68,15 @@ impl Ord for Event {
     }
 }
 
+/// A turn in a member's path: from time `t` of the step it is at
+/// `pos + vel (t' - t)`, until its next turn.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Kink {
+    pub t: f64,
+    pub pos: DVec3,
+    pub vel: DVec3,
+}
+
 /// One member's result of a finished run.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Member {
@@ -80,6 +92,10 @@ pub(super) struct Member {
     pub centre: DVec3,
     pub reach: f64,
     pub grew: bool,
+    /// Its turns: `kinks` of them from `kink0` on, in time order, in the
+    /// run's [`Run::kinks`] (then wherever the caller copies them).
+    pub kink0: u32,
+    pub kinks: u32,
 }
 
 /// Scratch for one run, kept to reuse memory.
@@ -103,6 +119,14 @@ pub(super) struct Run {
     pair_hits: Vec<u32>,
     heap: BinaryHeap<Event>,
     found: Vec<u32>,
+    /// Turns, by local index, in the order they happened; sorted by member
+    /// when the run ends.
+    turns: Vec<(u32, Kink)>,
+    kinks: Vec<Kink>,
+    kink_at: Vec<(u32, u32)>,
+    /// (member, member of another cluster) whose balls met: the caller
+    /// compares their paths when both runs are done.
+    pub cross: Vec<(u32, u32)>,
     /// Set when the run hit its event cap.
     pub capped: bool,
     /// Outsiders a member may touch: when not empty, the run's results are
@@ -134,6 +158,8 @@ impl Run {
         }
         self.conflicts.sort_unstable();
         self.conflicts.dedup();
+        self.cross.sort_unstable();
+        self.cross.dedup();
         self.conflicts.is_empty()
     }
 
@@ -164,6 +190,7 @@ impl Run {
                 let (imp, hits) = reflect_walls(&mut self.sp[la], mask);
                 self.wall_momentum[la] += imp;
                 self.wall_hits[la] += hits as u32;
+                self.turn(la, e.t);
                 self.rescan(sh, la, e.t, absorb);
             } else {
                 self.advance_to(lb, e.t);
@@ -172,6 +199,8 @@ impl Run {
                 if resolve_pair(x, y) {
                     self.pair_hits[la.min(lb)] += 1;
                 }
+                self.turn(la, e.t);
+                self.turn(lb, e.t);
                 self.rescan(sh, la, e.t, absorb);
                 self.rescan(sh, lb, e.t, absorb);
             }
@@ -188,6 +217,37 @@ impl Run {
             self.wall_momentum[l] += imp;
             self.wall_hits[l] += hits as u32;
         }
+        // Each member's turns together, still in time order (stable sort).
+        self.turns.sort_by_key(|&(l, _)| l);
+        self.kinks.clear();
+        self.kink_at.clear();
+        self.kink_at.resize(self.ids.len(), (0, 0));
+        for &(l, k) in &self.turns {
+            let at = &mut self.kink_at[l as usize];
+            if at.1 == 0 {
+                at.0 = self.kinks.len() as u32;
+            }
+            at.1 += 1;
+            self.kinks.push(k);
+        }
+    }
+
+    /// Member `l` changed velocity at `t` (it is there now).
+    fn turn(&mut self, l: usize, t: f64) {
+        let s = &self.sp[l];
+        self.turns.push((
+            l as u32,
+            Kink {
+                t,
+                pos: s.pos,
+                vel: s.vel,
+            },
+        ));
+    }
+
+    /// The turns of the last finished run's members (see [`Member::kink0`]).
+    pub fn kinks(&self) -> &[Kink] {
+        &self.kinks
     }
 
     /// The members of the last finished run.
@@ -201,6 +261,8 @@ impl Run {
             centre: self.centre[l],
             reach: self.reach[l],
             grew: self.reach[l] > self.reach0[l],
+            kink0: self.kink_at[l].0,
+            kinks: self.kink_at[l].1,
         })
     }
 
@@ -221,8 +283,10 @@ impl Run {
         self.wall_hits.clear();
         self.pair_hits.clear();
         self.heap.clear();
+        self.turns.clear();
         self.capped = false;
         self.conflicts.clear();
+        self.cross.clear();
     }
 
     /// Local index of sphere `j` if it is a member of this run.
@@ -331,8 +395,8 @@ impl Run {
             let l = self.member(j);
             if l.is_none() && sh.slot[j as usize] != NONE {
                 // A member of another cluster whose ball meets ours: its path
-                // is not known here.
-                self.conflicts.push(j);
+                // is not known here, so the caller compares the paths.
+                self.cross.push((ia, j));
                 continue;
             }
             let s = match l {

@@ -47,8 +47,19 @@ pub struct Swept {
     /// Per block of candidate pairs: the deepest overlap among them.
     overlap: Vec<Mutex<f64>>,
     rounds: Rounds,
+    /// Per block of spheres: what its spheres' events added up to.
+    tallies: Vec<Mutex<Tally>>,
     /// Detection already made for the next step of the world it names.
     ahead: Option<Ahead>,
+}
+
+/// One block of spheres' share of a step's counters.
+#[derive(Clone, Copy, Debug, Default)]
+struct Tally {
+    momentum: f64,
+    pairs: u64,
+    walls: u64,
+    capped: bool,
 }
 
 /// A detection made ahead of its step (when the engine asked for the
@@ -131,24 +142,46 @@ impl Swept {
         }
         self.rounds.run(
             exec,
-            &mut world.spheres,
+            &world.spheres,
             &self.detect.grid,
             size,
             dt,
             &self.meets,
             &self.near,
             &self.hits,
-            &mut world.counters,
         );
-        // Everyone without an event flies straight and meets no wall.
-        let rounds = &self.rounds;
+        // Spheres with events take their run's end; everyone else flies
+        // straight and meets no wall. The tallies are summed per block in
+        // sphere order, then block by block: the same bits on any lanes.
+        let blocks = world.spheres.len().div_ceil(SPHERE_BLOCK);
+        self.tallies.resize_with(blocks, Default::default);
+        let (rounds, tallies) = (&self.rounds, &self.tallies);
         for_each_chunk(exec, &mut world.spheres, SPHERE_BLOCK, &|b, chunk| {
+            let mut tally = Tally::default();
             for (k, s) in chunk.iter_mut().enumerate() {
-                if !rounds.involved(b * SPHERE_BLOCK + k) {
-                    s.pos += s.vel * dt;
+                match rounds.result(b * SPHERE_BLOCK + k) {
+                    Some((m, capped)) => {
+                        *s = m.sphere;
+                        tally.momentum += m.wall_momentum;
+                        tally.pairs += u64::from(m.pair_hits);
+                        tally.walls += u64::from(m.wall_hits);
+                        tally.capped |= capped;
+                    }
+                    None => s.pos += s.vel * dt,
                 }
             }
+            *tallies[b].lock() = tally;
         });
+        let c = &mut world.counters;
+        let mut capped = false;
+        for t in &self.tallies[..blocks] {
+            let t = *t.lock();
+            c.wall_momentum += t.momentum;
+            c.sphere_collisions += t.pairs;
+            c.wall_collisions += t.walls;
+            capped |= t.capped;
+        }
+        c.capped_steps += u64::from(capped);
     }
 
     /// Finds the pairs and walls of a step of `dt` from `world`; returns the

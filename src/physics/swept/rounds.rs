@@ -3,10 +3,14 @@
 //! The spheres with an event (a pair that meets, or a wall) are grouped:
 //! pairs that meet, and pairs of such spheres whose balls for the step
 //! overlap, end up in one cluster. Each cluster runs the serial event loop
-//! on its own (`cluster::Run`), on any lane. A run that finds it may touch
-//! a sphere outside its cluster is void; so are two clusters whose balls
-//! grew into each other. Those are merged (an outsider with no event joins)
-//! and run again, until a round ends with no conflict. When rounds go on
+//! on its own (`cluster::Run`), on any lane. A run that finds it meets a
+//! sphere with no events is void. Spheres of two clusters whose balls met
+//! after all (a member's ball grew into the other's as its path turned)
+//! are only noted; once every run of a round is done, their two paths,
+//! turn by turn, say whether they really come within touching distance
+//! (with a margin far above rounding). Those that do conflict. Conflicting
+//! clusters are merged (an outsider with no event joins) and run again,
+//! until a round ends with no conflict. When rounds go on
 //! too long, or merging leaves most spheres to run again, or over 30 % of
 //! the spheres have events from the start (clusters percolate), everything
 //! runs as one cluster that takes outsiders in as it meets them: the plain
@@ -18,15 +22,14 @@
 //! and whatever runs them: clusters that cannot touch each other have no
 //! events in common, events within one are taken in the same order (ties by
 //! sphere id), and totals are summed in sphere order.
-use super::cluster::{Member, Run, Shared};
+use super::cluster::{Kink, Member, Run, Shared};
 use super::{NONE, path_ball};
 use crate::physics::broad::Grid;
 use crate::physics::exec::{Exec, Serial, next_blocks};
 use crate::physics::sphere::Sphere;
-use crate::physics::world::Counters;
 use glam::DVec3;
 use parking_lot::Mutex;
-use std::sync::atomic::AtomicUsize;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Fewer grown balls than this are compared on one lane.
 const LANES_MIN_BALLS: usize = 8192;
@@ -43,8 +46,12 @@ struct BlockOut {
     /// Finished clusters: (capped, how many of `members` are theirs).
     done: Vec<(bool, u32)>,
     members: Vec<Member>,
+    /// The members' turns (`Member::kink0` indexes here).
+    kinks: Vec<Kink>,
     /// (a member, the outsider it may touch).
     conflicts: Vec<(u32, u32)>,
+    /// Finished runs' (member, member of another cluster) to compare.
+    cross: Vec<(u32, u32)>,
 }
 
 /// How a step's events were cut, for benches and tests.
@@ -57,6 +64,10 @@ pub struct RoundStats {
     pub reruns: usize,
     /// Spheres with events.
     pub involved: usize,
+    /// Pairs in different clusters whose paths were compared, and how many
+    /// of those were found apart (no rerun needed).
+    pub compared: usize,
+    pub apart: usize,
 }
 
 /// A cluster to run: members `order[m0..m1]`, meeting pairs
@@ -78,6 +89,15 @@ pub(super) struct Rounds {
     /// Slots from here on were added after the first round.
     first_late: usize,
     parent: Vec<u32>,
+    /// Each cluster's slots as a cycle (`next` of the last is the first),
+    /// so a merged cluster's members are found without scanning everyone.
+    next: Vec<u32>,
+    /// Roots marked dirty since the last partition (some merged since).
+    dirty_roots: Vec<u32>,
+    /// By slot: where its meeting pairs (as the pair's first sphere) start
+    /// in `meets_of`, indices into the step's `meets`.
+    meet_start: Vec<u32>,
+    meets_of: Vec<u32>,
     /// By root slot: the cluster must run (again).
     dirty: Vec<bool>,
     /// By slot: the member's result from its cluster's last finished run.
@@ -86,7 +106,6 @@ pub(super) struct Rounds {
     /// Slot → root slot, fixed during a round (the cluster's name).
     cluster_of: Vec<u32>,
     starts: Vec<u32>,
-    keys: Vec<u64>,
     order: Vec<u32>,
     pair_starts: Vec<u32>,
     pairs: Vec<(u32, u32)>,
@@ -95,6 +114,12 @@ pub(super) struct Rounds {
     runs: Vec<Mutex<Run>>,
     outs: Vec<Mutex<BlockOut>>,
     conflicts: Vec<(u32, u32)>,
+    /// Every finished member's turns (`Member::kink0` indexes here).
+    paths: Vec<Kink>,
+    /// (sphere, sphere of another cluster) whose paths must be compared,
+    /// from the standing runs; by slot, the round each one's run stands from.
+    cross: Vec<(u32, u32)>,
+    ran: Vec<u32>,
     /// Balls of the grown and late spheres, and a grid to find which meet.
     grown_slots: Vec<u32>,
     balls: Vec<Sphere>,
@@ -107,28 +132,36 @@ pub(super) struct Rounds {
 }
 
 impl Rounds {
-    /// Whether sphere `i` had an event in the last `run`.
+    /// Sphere `i`'s result of the last `run` (and whether its run hit the
+    /// event cap), if it had events.
     #[inline]
-    pub fn involved(&self, i: usize) -> bool {
-        self.slot[i] != NONE
+    pub fn result(&self, i: usize) -> Option<(&Member, bool)> {
+        match self.slot[i] {
+            NONE => None,
+            s => Some((
+                self.out[s as usize]
+                    .as_ref()
+                    .expect("every involved sphere finished"),
+                self.capped[s as usize],
+            )),
+        }
     }
 
     /// Runs the events of a step: `meets` are the pairs whose straight paths
     /// meet within `dt`, `near` pairs whose balls overlap but do not meet,
-    /// `hits` the spheres that reach a wall. Leaves every involved sphere
-    /// at the end of the step in `spheres` and adds to `counters`.
+    /// `hits` the spheres that reach a wall. Each involved sphere's end of
+    /// the step is then its [`Rounds::result`]; `spheres` is not changed.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &mut self,
         exec: &dyn Exec,
-        spheres: &mut [Sphere],
+        spheres: &[Sphere],
         grid: &Grid,
         size: f64,
         dt: f64,
         meets: &[(u32, u32)],
         near: &[(u32, u32)],
         hits: &[u32],
-        counters: &mut Counters,
     ) {
         let serial = self.start(spheres.len(), meets, near, hits);
         let mut round = 0;
@@ -155,12 +188,12 @@ impl Rounds {
                 self.stats.reruns += self.todo.len();
             }
             // A few events are not worth waking other threads for.
-            let exec: &dyn Exec = if absorb || self.order.len() < LANES_MIN_MEMBERS {
+            let lanes: &dyn Exec = if absorb || self.order.len() < LANES_MIN_MEMBERS {
                 &Serial
             } else {
                 exec
             };
-            self.reserve(exec);
+            self.reserve(lanes);
             let sh = Shared {
                 spheres,
                 grid,
@@ -168,9 +201,13 @@ impl Rounds {
                 size,
                 dt,
             };
-            self.run_clusters(exec, &sh, absorb);
+            self.run_clusters(lanes, &sh, absorb);
             self.collect();
-            // Grown balls are compared once the runs agree, not every round.
+            // Paths are compared once the runs agree, not every round; the
+            // grown balls (a grid over all of them) once the noted pairs agree.
+            if self.conflicts.is_empty() {
+                self.check_cross(spheres, dt);
+            }
             if self.conflicts.is_empty() {
                 self.check_grown(exec, spheres, size, dt);
             }
@@ -180,7 +217,6 @@ impl Rounds {
             self.merge_conflicts();
             round += 1;
         }
-        self.write_back(spheres, counters);
     }
 
     /// Slots for the spheres with events and their first clusters; true
@@ -191,23 +227,38 @@ impl Rounds {
         }
         self.slot.resize(n, NONE);
         self.ids.clear();
-        self.ids.extend(meets.iter().flat_map(|&(i, j)| [i, j]));
-        self.ids.extend_from_slice(hits);
-        self.ids.sort_unstable();
-        self.ids.dedup();
-        for (k, &i) in self.ids.iter().enumerate() {
-            self.slot[i as usize] = k as u32;
+        // Marked, then read off in order: one pass over the spheres costs
+        // less than sorting the tens of thousands of ends of the pairs.
+        for &(i, j) in meets {
+            self.slot[i as usize] = 0;
+            self.slot[j as usize] = 0;
+        }
+        for &i in hits {
+            self.slot[i as usize] = 0;
+        }
+        for (i, slot) in self.slot.iter_mut().enumerate() {
+            if *slot != NONE {
+                *slot = self.ids.len() as u32;
+                self.ids.push(i as u32);
+            }
         }
         let m = self.ids.len();
         self.first_late = m;
         self.parent.clear();
         self.parent.extend(0..m as u32);
+        self.next.clear();
+        self.next.extend(0..m as u32);
+        self.dirty_roots.clear();
         self.dirty.clear();
         self.dirty.resize(m, true);
         self.out.clear();
         self.out.resize(m, None);
         self.capped.clear();
         self.capped.resize(m, false);
+        self.ran.clear();
+        self.ran.resize(m, NONE);
+        self.paths.clear();
+        self.cross.clear();
         self.stats = RoundStats {
             involved: m,
             ..RoundStats::default()
@@ -218,7 +269,7 @@ impl Rounds {
         let serial = self.serial_only || 10 * m > 3 * n;
         if serial {
             // One cluster: every slot's parent is slot 0.
-            self.parent.fill(0);
+            self.merge_all();
             return true;
         }
         for &(i, j) in meets {
@@ -244,10 +295,21 @@ impl Rounds {
 
     /// Joins two slots' clusters; the joined cluster must run again.
     fn union(&mut self, a: u32, b: u32) {
+        let lo = self.link(a, b);
+        self.dirty[lo as usize] = true;
+        self.dirty_roots.push(lo);
+    }
+
+    /// Joins two slots' clusters under the lower root, which it returns.
+    fn link(&mut self, a: u32, b: u32) -> u32 {
         let (ra, rb) = (self.find(a), self.find(b));
         let (lo, hi) = (ra.min(rb), ra.max(rb));
-        self.parent[hi as usize] = lo;
-        self.dirty[lo as usize] = true;
+        if lo != hi {
+            self.parent[hi as usize] = lo;
+            // Splicing two cycles is swapping one successor of each.
+            self.next.swap(lo as usize, hi as usize);
+        }
+        lo
     }
 
     fn add_slot(&mut self, id: u32) -> u32 {
@@ -255,9 +317,12 @@ impl Rounds {
         self.slot[id as usize] = k;
         self.ids.push(id);
         self.parent.push(k);
+        self.next.push(k);
         self.dirty.push(true);
+        self.dirty_roots.push(k);
         self.out.push(None);
         self.capped.push(false);
+        self.ran.push(NONE);
         k
     }
 
@@ -265,90 +330,111 @@ impl Rounds {
     /// all the spheres with events, which no outsider with events can
     /// touch, so it finishes in one run.
     fn merge_all(&mut self) {
-        for s in 0..self.ids.len() {
+        let m = self.ids.len();
+        for s in 0..m {
             self.parent[s] = 0;
+            self.next[s] = ((s + 1) % m) as u32;
         }
-        if !self.ids.is_empty() {
+        if m > 0 {
             self.dirty[0] = true;
+            self.dirty_roots.push(0);
         }
     }
 
     /// This round's clusters (named by root slot) and the ones that must
-    /// run, with their members and meeting pairs, grouped by counting sort.
+    /// run, with their members and meeting pairs: everyone in the first
+    /// round, grouped by counting sort; later, only the clusters marked
+    /// dirty, found through their cycles.
     fn partition(&mut self, meets: &[(u32, u32)]) {
+        self.todo.clear();
+        if self.stats.rounds == 0 {
+            self.partition_all(meets);
+        } else {
+            self.partition_dirty(meets);
+        }
+    }
+
+    fn partition_all(&mut self, meets: &[(u32, u32)]) {
         let m = self.ids.len();
         self.cluster_of.resize(m, NONE);
         for s in 0..m as u32 {
             let r = self.find(s);
             self.cluster_of[s as usize] = r;
         }
-        let (cluster_of, dirty, slot, ids) = (&self.cluster_of, &self.dirty, &self.slot, &self.ids);
-        self.todo.clear();
-        if self.stats.rounds == 0 {
-            // Everyone runs: group by counting sort.
-            let member_roots = (0..m).map(|s| (cluster_of[s], ids[s]));
-            group(&mut self.starts, &mut self.order, m, member_roots);
-            let pair_roots = meets
-                .iter()
-                .map(|&(i, j)| (cluster_of[slot[i as usize] as usize], (i, j)));
-            group(&mut self.pair_starts, &mut self.pairs, m, pair_roots);
-            for r in 0..m {
-                let (m0, m1) = (self.starts[r], self.starts[r + 1]);
-                if m1 > m0 {
-                    self.todo.push(Todo {
-                        m0,
-                        m1,
-                        p0: self.pair_starts[r],
-                        p1: self.pair_starts[r + 1],
-                    });
+        self.dirty_roots.clear();
+        let (cluster_of, slot, ids) = (&self.cluster_of, &self.slot, &self.ids);
+        let member_roots = (0..m).map(|s| (cluster_of[s], ids[s]));
+        group(&mut self.starts, &mut self.order, m, member_roots);
+        let pair_roots = meets
+            .iter()
+            .map(|&(i, j)| (cluster_of[slot[i as usize] as usize], (i, j)));
+        group(&mut self.pair_starts, &mut self.pairs, m, pair_roots);
+        for r in 0..m {
+            let (m0, m1) = (self.starts[r], self.starts[r + 1]);
+            if m1 > m0 {
+                self.todo.push(Todo {
+                    m0,
+                    m1,
+                    p0: self.pair_starts[r],
+                    p1: self.pair_starts[r + 1],
+                });
+            }
+        }
+        // Each slot's meeting pairs, for the later rounds.
+        let by_slot = meets
+            .iter()
+            .enumerate()
+            .map(|(p, &(i, _))| (slot[i as usize], p as u32));
+        group(&mut self.meet_start, &mut self.meets_of, m, by_slot);
+    }
+
+    /// The clusters marked dirty since the last partition, each with its
+    /// members in sphere order and its meeting pairs in detection order
+    /// (as the first round has them), in order of their roots.
+    fn partition_dirty(&mut self, meets: &[(u32, u32)]) {
+        let mut roots = std::mem::take(&mut self.dirty_roots);
+        for r in &mut roots {
+            *r = self.find(*r);
+        }
+        roots.sort_unstable();
+        roots.dedup();
+        roots.retain(|&r| self.dirty[r as usize]);
+        self.cluster_of.resize(self.ids.len(), NONE);
+        self.order.clear();
+        self.pairs.clear();
+        let mut found: Vec<u32> = Vec::new();
+        let mut ps: Vec<u32> = Vec::new();
+        for &root in &roots {
+            found.clear();
+            ps.clear();
+            let mut s = root;
+            loop {
+                found.push(self.ids[s as usize]);
+                self.cluster_of[s as usize] = root;
+                // Slots added after the first round own no meeting pairs.
+                if (s as usize) < self.first_late {
+                    let (a, b) = (self.meet_start[s as usize], self.meet_start[s as usize + 1]);
+                    ps.extend_from_slice(&self.meets_of[a as usize..b as usize]);
+                }
+                s = self.next[s as usize];
+                if s == root {
+                    break;
                 }
             }
-            return;
-        }
-        // Later rounds run a few merged clusters: sort just those.
-        self.keys.clear();
-        self.keys.extend(
-            (0..m)
-                .filter(|&s| dirty[cluster_of[s] as usize])
-                .map(|s| (cluster_of[s] as u64) << 32 | ids[s] as u64),
-        );
-        self.keys.sort_unstable();
-        self.order.clear();
-        self.order.extend(self.keys.iter().map(|&k| k as u32));
-        let mut k = 0;
-        while k < self.keys.len() {
-            let root = self.keys[k] >> 32;
-            let m0 = k;
-            while k < self.keys.len() && self.keys[k] >> 32 == root {
-                k += 1;
-            }
+            found.sort_unstable();
+            ps.sort_unstable();
+            let (m0, p0) = (self.order.len() as u32, self.pairs.len() as u32);
+            self.order.extend_from_slice(&found);
+            self.pairs.extend(ps.iter().map(|&p| meets[p as usize]));
             self.todo.push(Todo {
-                m0: m0 as u32,
-                m1: k as u32,
-                p0: 0,
-                p1: 0,
+                m0,
+                m1: self.order.len() as u32,
+                p0,
+                p1: self.pairs.len() as u32,
             });
         }
-        self.keys.clear();
-        self.keys
-            .extend(meets.iter().enumerate().filter_map(|(p, &(i, _))| {
-                let r = cluster_of[slot[i as usize] as usize];
-                dirty[r as usize].then_some((r as u64) << 32 | p as u64)
-            }));
-        self.keys.sort_unstable();
-        self.pairs.clear();
-        self.pairs
-            .extend(self.keys.iter().map(|&k| meets[k as u32 as usize]));
-        // Both are sorted by root: walk them together.
-        let mut p = 0;
-        for t in &mut self.todo {
-            let root = cluster_of[slot[self.order[t.m0 as usize] as usize] as usize] as u64;
-            t.p0 = p as u32;
-            while p < self.keys.len() && self.keys[p] >> 32 == root {
-                p += 1;
-            }
-            t.p1 = p as u32;
-        }
+        roots.clear();
+        self.dirty_roots = roots;
     }
 
     /// Scratch for `run_clusters` on `exec`.
@@ -377,14 +463,22 @@ impl Rounds {
                 let mut out = outs[b].lock();
                 out.done.clear();
                 out.members.clear();
+                out.kinks.clear();
                 out.conflicts.clear();
+                out.cross.clear();
                 let end = ((b + 1) * CLUSTER_BLOCK).min(todo.len());
                 for t in &todo[b * CLUSTER_BLOCK..end] {
                     let members = &order[t.m0 as usize..t.m1 as usize];
                     let cp = &pairs[t.p0 as usize..t.p1 as usize];
                     if run.run(sh, members, cp, absorb) {
                         let before = out.members.len();
-                        out.members.extend(run.members());
+                        let base = out.kinks.len() as u32;
+                        out.kinks.extend_from_slice(run.kinks());
+                        out.members.extend(run.members().map(|mut m| {
+                            m.kink0 += base;
+                            m
+                        }));
+                        out.cross.extend_from_slice(&run.cross);
                         let len = (out.members.len() - before) as u32;
                         out.done.push((run.capped, len));
                     } else {
@@ -401,6 +495,9 @@ impl Rounds {
     /// their slots; conflicts are kept for merging.
     fn collect(&mut self) {
         self.conflicts.clear();
+        let round = self.stats.rounds as u32;
+        let mut cross = std::mem::take(&mut self.cross);
+        let fresh = cross.len();
         let outs = std::mem::take(&mut self.outs);
         for block in &outs[..self.todo.len().div_ceil(CLUSTER_BLOCK)] {
             let out = block.lock();
@@ -416,22 +513,65 @@ impl Rounds {
                         NONE => self.add_slot(m.id),
                         s => s,
                     };
-                    self.out[s as usize] = Some(*m);
+                    let turns = &out.kinks[m.kink0 as usize..(m.kink0 + m.kinks) as usize];
+                    let kink0 = self.paths.len() as u32;
+                    self.paths.extend_from_slice(turns);
+                    self.out[s as usize] = Some(Member { kink0, ..*m });
                     self.capped[s as usize] = capped;
-                    let r = self.find(s);
-                    if root == NONE {
-                        root = r;
-                    } else if r != root {
-                        let (lo, hi) = (r.min(root), r.max(root));
-                        self.parent[hi as usize] = lo;
-                        root = lo;
-                    }
+                    self.ran[s as usize] = round;
+                    root = if root == NONE {
+                        self.find(s)
+                    } else {
+                        self.link(root, s)
+                    };
                 }
                 self.dirty[root as usize] = false;
             }
             self.conflicts.extend_from_slice(&out.conflicts);
+            cross.extend_from_slice(&out.cross);
         }
         self.outs = outs;
+        // What a rerun cluster noted before is replaced by what it noted now.
+        let (slot, ran) = (&self.slot, &self.ran);
+        let mut k = 0;
+        cross.retain(|&(a, _)| {
+            k += 1;
+            k > fresh || ran[slot[a as usize] as usize] != round
+        });
+        self.cross = cross;
+    }
+
+    /// Pairs of spheres in different clusters whose balls met during a run
+    /// conflict if their paths really come within touching distance.
+    fn check_cross(&mut self, spheres: &[Sphere], dt: f64) {
+        for k in 0..self.cross.len() {
+            let (a, b) = self.cross[k];
+            let (sa, sb) = (self.slot[a as usize], self.slot[b as usize]);
+            if self.find(sa) != self.find(sb) {
+                self.compare(sa, sb, spheres, dt);
+            }
+        }
+    }
+
+    /// Slots `a` and `b` (different clusters) conflict if their paths meet.
+    fn compare(&mut self, a: u32, b: u32, spheres: &[Sphere], dt: f64) {
+        self.stats.compared += 1;
+        if self.view(spheres, dt).meet(a as usize, b as usize) {
+            self.conflicts
+                .push((self.ids[a as usize], self.ids[b as usize]));
+        } else {
+            self.stats.apart += 1;
+        }
+    }
+
+    fn view<'a>(&'a self, spheres: &'a [Sphere], dt: f64) -> Paths<'a> {
+        Paths {
+            out: &self.out,
+            capped: &self.capped,
+            turns: &self.paths,
+            spheres,
+            dt,
+        }
     }
 
     /// A finished cluster whose member's ball grew was checked against the
@@ -474,13 +614,29 @@ impl Rounds {
         );
         let mut pairs = std::mem::take(&mut self.overlap_pairs);
         let (out, slots, cluster_of) = (&self.out, &self.grown_slots, &self.cluster_of);
+        let paths = Paths {
+            out,
+            capped: &self.capped,
+            turns: &self.paths,
+            spheres,
+            dt,
+        };
+        let compared = AtomicUsize::new(0);
         let grew = |k: u32| out[slots[k as usize] as usize].is_some_and(|m| m.grew);
-        let apart = |a: u32, b: u32| {
+        // The paths are compared in the pair search, on its lanes.
+        let meet = |a: u32, b: u32| {
             let (sa, sb) = (slots[a as usize] as usize, slots[b as usize] as usize);
-            (grew(a) || grew(b)) && cluster_of[sa] != cluster_of[sb]
+            if !(grew(a) || grew(b)) || cluster_of[sa] == cluster_of[sb] {
+                return false;
+            }
+            compared.fetch_add(1, Ordering::Relaxed);
+            paths.meet(sa, sb)
         };
         self.overlap
-            .pairs(small(exec, self.balls.len()), &apart, &mut pairs);
+            .pairs(small(exec, self.balls.len()), &meet, &mut pairs);
+        let compared = compared.into_inner();
+        self.stats.compared += compared;
+        self.stats.apart += compared - pairs.len();
         for &(a, b) in &pairs {
             let (sa, sb) = (self.grown_slots[a as usize], self.grown_slots[b as usize]);
             self.conflicts
@@ -509,39 +665,80 @@ impl Rounds {
         }
         self.conflicts = conflicts;
     }
+}
 
-    fn write_back(&mut self, spheres: &mut [Sphere], counters: &mut Counters) {
-        let mut any_capped = false;
-        for (s, m) in self.out.iter().enumerate() {
-            let m = m.expect("every involved sphere finished");
-            spheres[m.id as usize] = m.sphere;
-            counters.sphere_collisions += m.pair_hits as u64;
-            counters.wall_collisions += m.wall_hits as u64;
-            any_capped |= self.capped[s];
+/// The paths the finished runs took, by slot.
+struct Paths<'a> {
+    out: &'a [Option<Member>],
+    capped: &'a [bool],
+    turns: &'a [Kink],
+    spheres: &'a [Sphere],
+    dt: f64,
+}
+
+impl Paths<'_> {
+    /// Whether the spheres of slots `a` and `b` come within touching
+    /// distance during the step. A capped run's path is not fully known: it
+    /// meets everyone.
+    fn meet(&self, a: usize, b: usize) -> bool {
+        if self.capped[a] || self.capped[b] {
+            return true;
         }
-        // The wall momentum is summed in sphere order, however the rounds
-        // went: the first slots are in id order, the late ones are merged in.
-        let mut late: Vec<(u32, f64)> = self.out[self.first_late..]
-            .iter()
-            .map(|m| m.map(|m| (m.id, m.wall_momentum)).expect("finished"))
-            .collect();
-        late.sort_unstable_by_key(|&(id, _)| id);
-        let mut late = late.into_iter().peekable();
-        for m in self.out[..self.first_late].iter().flatten() {
-            while let Some(&(id, p)) = late.peek()
-                && id < m.id
-            {
-                counters.wall_momentum += p;
-                late.next();
-            }
-            counters.wall_momentum += m.wall_momentum;
+        let path = |s: usize| {
+            let m = self.out[s].expect("a finished run's member");
+            let turns = &self.turns[m.kink0 as usize..(m.kink0 + m.kinks) as usize];
+            (&self.spheres[m.id as usize], turns)
+        };
+        let ((sa, ta), (sb, tb)) = (path(a), path(b));
+        paths_meet(sa, ta, sb, tb, self.dt)
+    }
+}
+
+/// Relative margin on the touching distance when comparing two paths: far
+/// above the rounding of positions (about 1e-16 of the box), so a pair the
+/// serial loop would see touch is never passed as apart.
+const PATH_MARGIN: f64 = 1e-8;
+
+/// Whether two spheres, from `a` and `b` at the start of the step and
+/// turning as `ta` and `tb` say (time order), come within the sum of their
+/// radii (widened by [`PATH_MARGIN`]) at one moment of `0..=dt`: on each
+/// stretch where both fly straight, the closest approach of the two lines.
+fn paths_meet(a: &Sphere, ta: &[Kink], b: &Sphere, tb: &[Kink], dt: f64) -> bool {
+    let sigma = (a.radius + b.radius) * (1.0 + PATH_MARGIN);
+    let start = |s: &Sphere| Kink {
+        t: 0.0,
+        pos: s.pos,
+        vel: s.vel,
+    };
+    let (mut ka, mut kb) = (start(a), start(b));
+    let (mut ia, mut ib) = (0, 0);
+    let mut t0 = 0.0;
+    loop {
+        let next = |turns: &[Kink], i: usize| turns.get(i).map_or(dt, |k| k.t.min(dt));
+        let t1 = next(ta, ia).min(next(tb, ib));
+        let dp = (ka.pos + ka.vel * (t0 - ka.t)) - (kb.pos + kb.vel * (t0 - kb.t));
+        let dv = ka.vel - kb.vel;
+        let vv = dv.length_squared();
+        let s = if vv > 0.0 {
+            (-dp.dot(dv) / vv).clamp(0.0, t1 - t0)
+        } else {
+            0.0
+        };
+        if (dp + dv * s).length_squared() <= sigma * sigma {
+            return true;
         }
-        for (_, p) in late {
-            counters.wall_momentum += p;
+        if t1 >= dt {
+            return false;
         }
-        if any_capped {
-            counters.capped_steps += 1;
+        while ia < ta.len() && ta[ia].t <= t1 {
+            ka = ta[ia];
+            ia += 1;
         }
+        while ib < tb.len() && tb[ib].t <= t1 {
+            kb = tb[ib];
+            ib += 1;
+        }
+        t0 = t1;
     }
 }
 
@@ -579,4 +776,63 @@ fn group<T: Copy + Default>(
 /// handing to other threads (each hand-off costs tens of microseconds).
 fn small(exec: &dyn Exec, n: usize) -> &dyn Exec {
     if n < LANES_MIN_BALLS { &Serial } else { exec }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sphere(pos: [f64; 3], vel: [f64; 3]) -> Sphere {
+        Sphere {
+            pos: DVec3::from(pos),
+            vel: DVec3::from(vel),
+            radius: 0.1,
+            mass: 1.0,
+        }
+    }
+
+    fn turn(t: f64, pos: [f64; 3], vel: [f64; 3]) -> Kink {
+        Kink {
+            t,
+            pos: DVec3::from(pos),
+            vel: DVec3::from(vel),
+        }
+    }
+
+    #[test]
+    fn crossing_lines_meet_only_at_the_same_time() {
+        // Both pass through the origin: at t = 1 together, or a second apart.
+        let a = sphere([-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
+        let together = sphere([0.0, -1.0, 0.0], [0.0, 1.0, 0.0]);
+        let late = sphere([0.0, -2.0, 0.0], [0.0, 1.0, 0.0]);
+        assert!(paths_meet(&a, &[], &together, &[], 2.0));
+        assert!(!paths_meet(&a, &[], &late, &[], 2.0));
+        // Closest approach after the step ends does not count.
+        assert!(!paths_meet(&a, &[], &together, &[], 0.5));
+        // Just outside and just inside touching distance (0.2).
+        let by = |gap: f64| sphere([0.0, gap, 0.0], [1.0, 0.0, 0.0]);
+        let still = sphere([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
+        assert!(!paths_meet(&still, &[], &by(0.2 * (1.0 + 1e-6)), &[], 1.0));
+        assert!(paths_meet(&still, &[], &by(0.2 * (1.0 - 1e-6)), &[], 1.0));
+    }
+
+    #[test]
+    fn a_turn_decides_whether_paths_meet() {
+        // `b` waits at (0, 1, 0). `a` heads along x; turned up at t = 1 (at
+        // the origin) it touches `b` at t = 1.8; turned down it never does,
+        // and straight it passes 1 away.
+        let a = sphere([-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
+        let b = sphere([0.0, 1.0, 0.0], [0.0, 0.0, 0.0]);
+        let up = [turn(1.0, [0.0, 0.0, 0.0], [0.0, 1.0, 0.0])];
+        let down = [turn(1.0, [0.0, 0.0, 0.0], [0.0, -1.0, 0.0])];
+        assert!(!paths_meet(&a, &[], &b, &[], 3.0));
+        assert!(paths_meet(&a, &up, &b, &[], 3.0));
+        assert!(paths_meet(&b, &[], &a, &up, 3.0), "either order");
+        assert!(!paths_meet(&a, &down, &b, &[], 3.0));
+        // The meeting at t = 1.8 lies past a step of 1.5.
+        assert!(!paths_meet(&a, &up, &b, &[], 1.5));
+        // Both turn: `b` runs off along +y at t = 0.5 and stays ahead.
+        let away = [turn(0.5, [0.0, 1.0, 0.0], [0.0, 2.0, 0.0])];
+        assert!(!paths_meet(&a, &up, &b, &away, 3.0));
+    }
 }
