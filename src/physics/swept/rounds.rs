@@ -3,25 +3,26 @@
 //! The spheres with an event (a pair that meets, or a wall) are grouped:
 //! pairs that meet, and pairs of such spheres whose balls for the step
 //! overlap, end up in one cluster. Each cluster runs the serial event loop
-//! on its own (`cluster::Run`), on any lane. A run that finds it meets a
-//! sphere with no events is void. Spheres of two clusters whose balls met
-//! after all (a member's ball grew into the other's as its path turned)
-//! are only noted; once every run of a round is done, their two paths,
-//! turn by turn, say whether they really come within touching distance
-//! (with a margin far above rounding). Those that do conflict. Conflicting
-//! clusters are merged (an outsider with no event joins) and run again,
-//! until a round ends with no conflict. When rounds go on
-//! too long, or merging leaves most spheres to run again, or over 30 % of
-//! the spheres have events from the start (clusters percolate), everything
-//! runs as one cluster that takes outsiders in as it meets them: the plain
-//! serial event loop. One lane runs clusters too: small event queues and
-//! rescans that check a few members directly cost less than one queue for
-//! the whole step.
+//! on its own (`cluster::Run`), on any lane; a sphere with no events that a
+//! run meets joins that run. Spheres of two clusters whose balls met after
+//! all (a member's ball grew into the other's as its path turned) are only
+//! noted. Once every run of a round is done, the paths decide, turn by turn,
+//! whether such pairs really come within touching distance (with a margin
+//! far above rounding), and so do all balls that meet where one sphere's
+//! path turned or was taken in by a run (the others took it to fly
+//! straight). Those that do conflict, as do two runs that took in the same
+//! sphere: conflicting clusters are merged and run again, until a round
+//! ends with no conflict. When rounds go on too long, or merging leaves
+//! most spheres to run again, or over 30 % of the spheres have events from
+//! the start (clusters percolate), everything runs as one cluster: the
+//! plain serial event loop. One lane runs clusters too: small event queues
+//! and rescans that check a few members directly cost less than one queue
+//! for the whole step.
 //!
 //! The result is the serial loop's, bit for bit, however the clusters fall
 //! and whatever runs them: clusters that cannot touch each other have no
 //! events in common, events within one are taken in the same order (ties by
-//! sphere id), and totals are summed in sphere order.
+//! sphere id), and totals are summed in a fixed order.
 use super::cluster::{Kink, Member, Run, Shared};
 use super::{NONE, path_ball};
 use crate::physics::broad::Grid;
