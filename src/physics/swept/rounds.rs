@@ -33,7 +33,7 @@ use parking_lot::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Fewer grown balls than this are compared on one lane.
-const LANES_MIN_BALLS: usize = 8192;
+const LANES_MIN_BALLS: usize = 2048;
 /// Fewer spheres with events than this run their clusters on one lane.
 const LANES_MIN_MEMBERS: usize = 512;
 /// Clusters per parallel block.
@@ -97,6 +97,8 @@ pub(super) struct Rounds {
     /// in `meets_of`, indices into the step's `meets`.
     meet_start: Vec<u32>,
     meets_of: Vec<u32>,
+    /// Whether `meet_start` holds this step's (built when first needed).
+    meets_indexed: bool,
     /// By root slot: the cluster must run (again).
     dirty: Vec<bool>,
     /// By slot: the member's result from its cluster's last finished run.
@@ -378,18 +380,32 @@ impl Rounds {
                 });
             }
         }
-        // Each slot's meeting pairs, for the later rounds.
+        self.meets_indexed = false;
+    }
+
+    /// Each first-round slot's meeting pairs, for the later rounds.
+    fn index_meets(&mut self, meets: &[(u32, u32)]) {
+        let slot = &self.slot;
         let by_slot = meets
             .iter()
             .enumerate()
             .map(|(p, &(i, _))| (slot[i as usize], p as u32));
-        group(&mut self.meet_start, &mut self.meets_of, m, by_slot);
+        group(
+            &mut self.meet_start,
+            &mut self.meets_of,
+            self.first_late,
+            by_slot,
+        );
+        self.meets_indexed = true;
     }
 
     /// The clusters marked dirty since the last partition, each with its
     /// members in sphere order and its meeting pairs in detection order
     /// (as the first round has them), in order of their roots.
     fn partition_dirty(&mut self, meets: &[(u32, u32)]) {
+        if !self.meets_indexed {
+            self.index_meets(meets);
+        }
         let mut roots = std::mem::take(&mut self.dirty_roots);
         for r in &mut roots {
             *r = self.find(*r);
