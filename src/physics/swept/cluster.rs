@@ -1,12 +1,12 @@
 //! One cluster's contact events within a step, on private copies of its
 //! spheres: the serial event loop of `swept` (time order, lazy clocks,
 //! collision counters, rescans on every velocity change), run for a set of
-//! spheres that should not touch anyone outside it. When a rescan finds an
-//! outsider with no events of its own that it meets, the run is void and
-//! names it, so the caller can merge and run again; a member of another
-//! cluster, whose path is not known here, is only noted, and the caller
-//! checks the two paths once both runs are done (see `rounds`). Each
-//! member's path is kept as the turns it took.
+//! spheres that should not touch anyone outside it. An outsider with no
+//! events of its own that a member meets joins the run (the caller sees it
+//! if two runs took the same one in); a member of another cluster, whose
+//! path is not known here, is only noted, and the caller checks the two
+//! paths once both runs are done (see `rounds`). Each member's path is kept
+//! as the turns it took.
 use super::{NONE, REACH_SLACK, path_ball};
 use crate::physics::broad::Grid;
 use crate::physics::contact::{pair_toi, reflect_walls, resolve_pair, wall_toi};
@@ -129,25 +129,13 @@ pub(super) struct Run {
     pub cross: Vec<(u32, u32)>,
     /// Set when the run hit its event cap.
     pub capped: bool,
-    /// Outsiders a member may touch: when not empty, the run's results are
-    /// void and it names whom to merge with. A doomed run goes on to the
-    /// end so that one round finds all it must merge with.
-    pub conflicts: Vec<u32>,
 }
 
 impl Run {
-    /// Runs the events of a cluster (its `members` and the
-    /// `pairs` detection found among them); true when it is valid (no
-    /// conflicts). With `absorb`, a sphere outside every cluster that a
-    /// member meets joins this run instead of conflicting (safe only when
-    /// no other run is going on).
-    pub fn run(
-        &mut self,
-        sh: &Shared,
-        members: &[u32],
-        pairs: &[(u32, u32)],
-        absorb: bool,
-    ) -> bool {
+    /// Runs the events of a cluster (its `members` and the `pairs`
+    /// detection found among them). `absorb`: this is the one run of the
+    /// step's last round, holding everyone with events.
+    pub fn run(&mut self, sh: &Shared, members: &[u32], pairs: &[(u32, u32)], absorb: bool) {
         self.clear(sh.spheres.len());
         for &i in members {
             self.involve(sh, i);
@@ -156,11 +144,8 @@ impl Run {
         for &i in &self.ids {
             self.local_of[i as usize] = NONE;
         }
-        self.conflicts.sort_unstable();
-        self.conflicts.dedup();
         self.cross.sort_unstable();
         self.cross.dedup();
-        self.conflicts.is_empty()
     }
 
     fn events(&mut self, sh: &Shared, pairs: &[(u32, u32)], absorb: bool) {
@@ -285,7 +270,6 @@ impl Run {
         self.heap.clear();
         self.turns.clear();
         self.capped = false;
-        self.conflicts.clear();
         self.cross.clear();
     }
 
@@ -421,13 +405,11 @@ impl Run {
             if t + dtc > sh.dt {
                 continue;
             }
+            // A sphere with no events that a member meets joins the run;
+            // if another run took it in too, the caller sees it taken twice.
             let lb = match l {
                 Some(l) => l as u32,
-                None if absorb => self.involve(sh, j),
-                None => {
-                    self.conflicts.push(j);
-                    continue;
-                }
+                None => self.involve(sh, j),
             };
             let cb = self.count[lb as usize];
             self.heap

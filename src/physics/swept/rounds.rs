@@ -3,25 +3,26 @@
 //! The spheres with an event (a pair that meets, or a wall) are grouped:
 //! pairs that meet, and pairs of such spheres whose balls for the step
 //! overlap, end up in one cluster. Each cluster runs the serial event loop
-//! on its own (`cluster::Run`), on any lane. A run that finds it meets a
-//! sphere with no events is void. Spheres of two clusters whose balls met
-//! after all (a member's ball grew into the other's as its path turned)
-//! are only noted; once every run of a round is done, their two paths,
-//! turn by turn, say whether they really come within touching distance
-//! (with a margin far above rounding). Those that do conflict. Conflicting
-//! clusters are merged (an outsider with no event joins) and run again,
-//! until a round ends with no conflict. When rounds go on
-//! too long, or merging leaves most spheres to run again, or over 30 % of
-//! the spheres have events from the start (clusters percolate), everything
-//! runs as one cluster that takes outsiders in as it meets them: the plain
-//! serial event loop. One lane runs clusters too: small event queues and
-//! rescans that check a few members directly cost less than one queue for
-//! the whole step.
+//! on its own (`cluster::Run`), on any lane; a sphere with no events that a
+//! run meets joins that run. Spheres of two clusters whose balls met after
+//! all (a member's ball grew into the other's as its path turned) are only
+//! noted. Once every run of a round is done, the paths decide, turn by turn,
+//! whether such pairs really come within touching distance (with a margin
+//! far above rounding), and so do all balls that meet where one sphere's
+//! path turned or was taken in by a run (the others took it to fly
+//! straight). Those that do conflict, as do two runs that took in the same
+//! sphere: conflicting clusters are merged and run again, until a round
+//! ends with no conflict. When rounds go on too long, or merging leaves
+//! most spheres to run again, or over 30 % of the spheres have events from
+//! the start (clusters percolate), everything runs as one cluster: the
+//! plain serial event loop. One lane runs clusters too: small event queues
+//! and rescans that check a few members directly cost less than one queue
+//! for the whole step.
 //!
 //! The result is the serial loop's, bit for bit, however the clusters fall
 //! and whatever runs them: clusters that cannot touch each other have no
 //! events in common, events within one are taken in the same order (ties by
-//! sphere id), and totals are summed in sphere order.
+//! sphere id), and totals are summed in a fixed order.
 use super::cluster::{Kink, Member, Run, Shared};
 use super::{NONE, path_ball};
 use crate::physics::broad::Grid;
@@ -32,7 +33,7 @@ use parking_lot::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Fewer grown balls than this are compared on one lane.
-const LANES_MIN_BALLS: usize = 8192;
+const LANES_MIN_BALLS: usize = 2048;
 /// Fewer spheres with events than this run their clusters on one lane.
 const LANES_MIN_MEMBERS: usize = 512;
 /// Clusters per parallel block.
@@ -48,8 +49,6 @@ struct BlockOut {
     members: Vec<Member>,
     /// The members' turns (`Member::kink0` indexes here).
     kinks: Vec<Kink>,
-    /// (a member, the outsider it may touch).
-    conflicts: Vec<(u32, u32)>,
     /// Finished runs' (member, member of another cluster) to compare.
     cross: Vec<(u32, u32)>,
 }
@@ -98,6 +97,8 @@ pub(super) struct Rounds {
     /// in `meets_of`, indices into the step's `meets`.
     meet_start: Vec<u32>,
     meets_of: Vec<u32>,
+    /// Whether `meet_start` holds this step's (built when first needed).
+    meets_indexed: bool,
     /// By root slot: the cluster must run (again).
     dirty: Vec<bool>,
     /// By slot: the member's result from its cluster's last finished run.
@@ -120,8 +121,7 @@ pub(super) struct Rounds {
     /// from the standing runs; by slot, the round each one's run stands from.
     cross: Vec<(u32, u32)>,
     ran: Vec<u32>,
-    /// Balls of the grown and late spheres, and a grid to find which meet.
-    grown_slots: Vec<u32>,
+    /// Every slot's ball for the step, and a grid to find which meet.
     balls: Vec<Sphere>,
     overlap: Grid,
     overlap_pairs: Vec<(u32, u32)>,
@@ -380,18 +380,32 @@ impl Rounds {
                 });
             }
         }
-        // Each slot's meeting pairs, for the later rounds.
+        self.meets_indexed = false;
+    }
+
+    /// Each first-round slot's meeting pairs, for the later rounds.
+    fn index_meets(&mut self, meets: &[(u32, u32)]) {
+        let slot = &self.slot;
         let by_slot = meets
             .iter()
             .enumerate()
             .map(|(p, &(i, _))| (slot[i as usize], p as u32));
-        group(&mut self.meet_start, &mut self.meets_of, m, by_slot);
+        group(
+            &mut self.meet_start,
+            &mut self.meets_of,
+            self.first_late,
+            by_slot,
+        );
+        self.meets_indexed = true;
     }
 
     /// The clusters marked dirty since the last partition, each with its
     /// members in sphere order and its meeting pairs in detection order
     /// (as the first round has them), in order of their roots.
     fn partition_dirty(&mut self, meets: &[(u32, u32)]) {
+        if !self.meets_indexed {
+            self.index_meets(meets);
+        }
         let mut roots = std::mem::take(&mut self.dirty_roots);
         for r in &mut roots {
             *r = self.find(*r);
@@ -464,28 +478,22 @@ impl Rounds {
                 out.done.clear();
                 out.members.clear();
                 out.kinks.clear();
-                out.conflicts.clear();
                 out.cross.clear();
                 let end = ((b + 1) * CLUSTER_BLOCK).min(todo.len());
                 for t in &todo[b * CLUSTER_BLOCK..end] {
                     let members = &order[t.m0 as usize..t.m1 as usize];
                     let cp = &pairs[t.p0 as usize..t.p1 as usize];
-                    if run.run(sh, members, cp, absorb) {
-                        let before = out.members.len();
-                        let base = out.kinks.len() as u32;
-                        out.kinks.extend_from_slice(run.kinks());
-                        out.members.extend(run.members().map(|mut m| {
-                            m.kink0 += base;
-                            m
-                        }));
-                        out.cross.extend_from_slice(&run.cross);
-                        let len = (out.members.len() - before) as u32;
-                        out.done.push((run.capped, len));
-                    } else {
-                        let first = members[0];
-                        out.conflicts
-                            .extend(run.conflicts.iter().map(|&j| (first, j)));
-                    }
+                    run.run(sh, members, cp, absorb);
+                    let before = out.members.len();
+                    let base = out.kinks.len() as u32;
+                    out.kinks.extend_from_slice(run.kinks());
+                    out.members.extend(run.members().map(|mut m| {
+                        m.kink0 += base;
+                        m
+                    }));
+                    out.cross.extend_from_slice(&run.cross);
+                    let len = (out.members.len() - before) as u32;
+                    out.done.push((run.capped, len));
                 }
             }
         });
@@ -496,6 +504,8 @@ impl Rounds {
     fn collect(&mut self) {
         self.conflicts.clear();
         let round = self.stats.rounds as u32;
+        // Slots from here on are spheres runs took in this round.
+        let known = self.ids.len();
         let mut cross = std::mem::take(&mut self.cross);
         let fresh = cross.len();
         let outs = std::mem::take(&mut self.outs);
@@ -508,11 +518,15 @@ impl Rounds {
                 // A run that took outsiders in (the absorbing round) has them
                 // as members now.
                 let mut root = NONE;
+                let mut twice = false;
                 for m in members {
                     let s = match self.slot[m.id as usize] {
                         NONE => self.add_slot(m.id),
                         s => s,
                     };
+                    // Taken in by an earlier run of this round too: the two
+                    // runs join (below) and run again.
+                    twice |= s as usize >= known && self.ran[s as usize] == round;
                     let turns = &out.kinks[m.kink0 as usize..(m.kink0 + m.kinks) as usize];
                     let kink0 = self.paths.len() as u32;
                     self.paths.extend_from_slice(turns);
@@ -525,9 +539,14 @@ impl Rounds {
                         self.link(root, s)
                     };
                 }
-                self.dirty[root as usize] = false;
+                if twice {
+                    self.union(root, root);
+                    let first = members[0].id;
+                    self.conflicts.push((first, first));
+                } else {
+                    self.dirty[root as usize] = false;
+                }
             }
-            self.conflicts.extend_from_slice(&out.conflicts);
             cross.extend_from_slice(&out.cross);
         }
         self.outs = outs;
@@ -576,29 +595,25 @@ impl Rounds {
 
     /// A finished cluster whose member's ball grew was checked against the
     /// balls the grid holds, of spheres that had events then. Two such
-    /// grown balls, or a grown ball and a sphere that got events later (its
-    /// path no longer straight), may meet where no run could see it: such
-    /// pairs in different clusters conflict too.
+    /// grown balls, or any ball and that of a sphere a run took in (which
+    /// other runs took to fly straight), may meet where no run could see
+    /// it: such pairs in different clusters are compared by their paths.
     fn check_grown(&mut self, exec: &dyn Exec, spheres: &[Sphere], size: f64, dt: f64) {
-        self.grown_slots.clear();
-        self.balls.clear();
-        let mut any_grew = false;
-        for s in 0..self.ids.len() {
-            let grew = self.out[s].is_some_and(|m| m.grew);
-            any_grew |= grew;
-            if grew || s >= self.first_late {
-                let (centre, reach) = self.ball(s, spheres, dt);
-                self.grown_slots.push(s as u32);
-                self.balls.push(Sphere {
-                    pos: centre,
-                    vel: DVec3::ZERO,
-                    radius: reach,
-                    mass: 0.0,
-                });
-            }
-        }
-        if !any_grew || self.balls.len() < 2 {
+        let any_changed =
+            self.ids.len() > self.first_late || self.out.iter().any(|m| m.is_some_and(|m| m.grew));
+        if !any_changed || self.ids.len() < 2 {
             return;
+        }
+        // Every slot's ball, indexed by slot.
+        self.balls.clear();
+        for s in 0..self.ids.len() {
+            let (centre, reach) = self.ball(s, spheres, dt);
+            self.balls.push(Sphere {
+                pos: centre,
+                vel: DVec3::ZERO,
+                radius: reach,
+                mass: 0.0,
+            });
         }
         // The absorbing round joins clusters: name them afresh.
         self.cluster_of.resize(self.ids.len(), NONE);
@@ -613,7 +628,7 @@ impl Rounds {
             small(exec, self.balls.len()),
         );
         let mut pairs = std::mem::take(&mut self.overlap_pairs);
-        let (out, slots, cluster_of) = (&self.out, &self.grown_slots, &self.cluster_of);
+        let (out, cluster_of) = (&self.out, &self.cluster_of);
         let paths = Paths {
             out,
             capped: &self.capped,
@@ -622,11 +637,12 @@ impl Rounds {
             dt,
         };
         let compared = AtomicUsize::new(0);
-        let grew = |k: u32| out[slots[k as usize] as usize].is_some_and(|m| m.grew);
+        let first_late = self.first_late;
+        let changed = |s: usize| s >= first_late || out[s].is_some_and(|m| m.grew);
         // The paths are compared in the pair search, on its lanes.
         let meet = |a: u32, b: u32| {
-            let (sa, sb) = (slots[a as usize] as usize, slots[b as usize] as usize);
-            if !(grew(a) || grew(b)) || cluster_of[sa] == cluster_of[sb] {
+            let (sa, sb) = (a as usize, b as usize);
+            if !(changed(sa) || changed(sb)) || cluster_of[sa] == cluster_of[sb] {
                 return false;
             }
             compared.fetch_add(1, Ordering::Relaxed);
@@ -638,9 +654,8 @@ impl Rounds {
         self.stats.compared += compared;
         self.stats.apart += compared - pairs.len();
         for &(a, b) in &pairs {
-            let (sa, sb) = (self.grown_slots[a as usize], self.grown_slots[b as usize]);
             self.conflicts
-                .push((self.ids[sa as usize], self.ids[sb as usize]));
+                .push((self.ids[a as usize], self.ids[b as usize]));
         }
         self.overlap_pairs = pairs;
     }
