@@ -39,7 +39,7 @@ fn accuracy_report() {
     println!(
         "exact N={N} packing=0.25: {} collisions in {secs:.2} s ({:.3} M/s incl. sampling); \
          energy drift {:.3e} (max {:.3e}); deepest overlap {:.3e} radius; escaped {}; capped {}; \
-         events: {} stale, {} walls, {} relists",
+         events: {} stale, {} walls, {} relists, {} crossings",
         w.counters.sphere_collisions,
         w.counters.sphere_collisions as f64 / secs / 1e6,
         (w.kinetic_energy() - e0).abs() / e0,
@@ -50,6 +50,7 @@ fn accuracy_report() {
         m.stats.stale - stats0.stale,
         m.stats.walls - stats0.walls,
         m.stats.relists - stats0.relists,
+        m.stats.crossings - stats0.crossings,
     );
 }
 
