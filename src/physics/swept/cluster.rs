@@ -81,6 +81,9 @@ pub(super) struct Kink {
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Member {
     pub id: u32,
+    /// Its slot among the spheres with events when the run began (NONE for
+    /// one the run took in).
+    pub slot: u32,
     pub sphere: Sphere,
     /// Momentum given to the walls, for the pressure.
     pub wall_momentum: f64,
@@ -102,6 +105,7 @@ pub(super) struct Member {
 #[derive(Default)]
 pub(super) struct Run {
     ids: Vec<u32>,
+    slots: Vec<u32>,
     /// Sphere id → local index for members, NONE for everyone else; kept
     /// so between runs (one lookup per candidate, the hot path).
     local_of: Vec<u32>,
@@ -239,6 +243,7 @@ impl Run {
     pub fn members(&self) -> impl Iterator<Item = Member> + '_ {
         (0..self.ids.len()).map(|l| Member {
             id: self.ids[l],
+            slot: self.slots[l],
             sphere: self.sp[l],
             wall_momentum: self.wall_momentum[l],
             wall_hits: self.wall_hits[l],
@@ -256,6 +261,7 @@ impl Run {
             self.local_of.resize(n, NONE);
         }
         self.ids.clear();
+        self.slots.clear();
         self.sp.clear();
         self.t_local.clear();
         self.count.clear();
@@ -289,6 +295,7 @@ impl Run {
         let s = sh.spheres[i as usize];
         self.local_of[i as usize] = l;
         self.ids.push(i);
+        self.slots.push(sh.slot[i as usize]);
         self.sp.push(s);
         self.t_local.push(0.0);
         self.count.push(0);

@@ -97,8 +97,11 @@ pub(super) struct Rounds {
     /// in `meets_of`, indices into the step's `meets`.
     meet_start: Vec<u32>,
     meets_of: Vec<u32>,
-    /// Whether `meet_start` holds this step's (built when first needed).
-    meets_indexed: bool,
+    /// By meeting pair: the slot of its first sphere.
+    meet_slot: Vec<u32>,
+    /// Scratch for one cluster's members and pairs.
+    found: Vec<u32>,
+    ps: Vec<u32>,
     /// By root slot: the cluster must run (again).
     dirty: Vec<bool>,
     /// By slot: the member's result from its cluster's last finished run.
@@ -106,9 +109,7 @@ pub(super) struct Rounds {
     capped: Vec<bool>,
     /// Slot → root slot, fixed during a round (the cluster's name).
     cluster_of: Vec<u32>,
-    starts: Vec<u32>,
     order: Vec<u32>,
-    pair_starts: Vec<u32>,
     pairs: Vec<(u32, u32)>,
     todo: Vec<Todo>,
     /// One run's scratch per lane, one output per block.
@@ -242,6 +243,9 @@ impl Rounds {
                 self.ids.push(i as u32);
             }
         }
+        self.meet_slot.clear();
+        self.meet_slot
+            .extend(meets.iter().map(|&(i, _)| self.slot[i as usize]));
         let m = self.ids.len();
         self.first_late = m;
         self.parent.clear();
@@ -355,57 +359,80 @@ impl Rounds {
     }
 
     fn partition_all(&mut self, meets: &[(u32, u32)]) {
-        let m = self.ids.len();
-        self.cluster_of.resize(m, NONE);
-        for s in 0..m as u32 {
-            let r = self.find(s);
-            self.cluster_of[s as usize] = r;
-        }
         self.dirty_roots.clear();
-        let (cluster_of, slot, ids) = (&self.cluster_of, &self.slot, &self.ids);
-        let member_roots = (0..m).map(|s| (cluster_of[s], ids[s]));
-        group(&mut self.starts, &mut self.order, m, member_roots);
-        let pair_roots = meets
-            .iter()
-            .map(|&(i, j)| (cluster_of[slot[i as usize] as usize], (i, j)));
-        group(&mut self.pair_starts, &mut self.pairs, m, pair_roots);
-        for r in 0..m {
-            let (m0, m1) = (self.starts[r], self.starts[r + 1]);
-            if m1 > m0 {
-                self.todo.push(Todo {
-                    m0,
-                    m1,
-                    p0: self.pair_starts[r],
-                    p1: self.pair_starts[r + 1],
-                });
+        self.index_meets(meets);
+        self.cluster_of.resize(self.ids.len(), NONE);
+        self.order.clear();
+        self.pairs.clear();
+        // Every cluster, by root (a root is its own parent), walked round
+        // its cycle.
+        for root in 0..self.ids.len() as u32 {
+            if self.parent[root as usize] == root {
+                self.push_cluster(root, meets);
             }
         }
-        self.meets_indexed = false;
     }
 
-    /// Each first-round slot's meeting pairs, for the later rounds.
+    /// Each first-round slot's meeting pairs (as the pair's first sphere).
     fn index_meets(&mut self, meets: &[(u32, u32)]) {
-        let slot = &self.slot;
-        let by_slot = meets
+        let by_slot = self
+            .meet_slot
             .iter()
-            .enumerate()
-            .map(|(p, &(i, _))| (slot[i as usize], p as u32));
+            .zip(0..meets.len() as u32)
+            .map(|(&s, p)| (s, p));
         group(
             &mut self.meet_start,
             &mut self.meets_of,
             self.first_late,
             by_slot,
         );
-        self.meets_indexed = true;
+    }
+
+    /// Cluster `root` as a run to make: its members in sphere order and its
+    /// meeting pairs in detection order (the order the first round has).
+    fn push_cluster(&mut self, root: u32, meets: &[(u32, u32)]) {
+        let (mut found, mut ps) = (
+            std::mem::take(&mut self.found),
+            std::mem::take(&mut self.ps),
+        );
+        found.clear();
+        ps.clear();
+        let mut s = root;
+        loop {
+            found.push(s);
+            self.cluster_of[s as usize] = root;
+            // Slots added after the first round own no meeting pairs.
+            if (s as usize) < self.first_late {
+                let (a, b) = (self.meet_start[s as usize], self.meet_start[s as usize + 1]);
+                ps.extend_from_slice(&self.meets_of[a as usize..b as usize]);
+            }
+            s = self.next[s as usize];
+            if s == root {
+                break;
+            }
+        }
+        // Slots of the first round are in sphere order; later ones are not.
+        for s in &mut found {
+            *s = self.ids[*s as usize];
+        }
+        found.sort_unstable();
+        ps.sort_unstable();
+        let (m0, p0) = (self.order.len() as u32, self.pairs.len() as u32);
+        self.order.extend_from_slice(&found);
+        self.pairs.extend(ps.iter().map(|&p| meets[p as usize]));
+        self.todo.push(Todo {
+            m0,
+            m1: self.order.len() as u32,
+            p0,
+            p1: self.pairs.len() as u32,
+        });
+        (self.found, self.ps) = (found, ps);
     }
 
     /// The clusters marked dirty since the last partition, each with its
     /// members in sphere order and its meeting pairs in detection order
     /// (as the first round has them), in order of their roots.
     fn partition_dirty(&mut self, meets: &[(u32, u32)]) {
-        if !self.meets_indexed {
-            self.index_meets(meets);
-        }
         let mut roots = std::mem::take(&mut self.dirty_roots);
         for r in &mut roots {
             *r = self.find(*r);
@@ -416,36 +443,8 @@ impl Rounds {
         self.cluster_of.resize(self.ids.len(), NONE);
         self.order.clear();
         self.pairs.clear();
-        let mut found: Vec<u32> = Vec::new();
-        let mut ps: Vec<u32> = Vec::new();
         for &root in &roots {
-            found.clear();
-            ps.clear();
-            let mut s = root;
-            loop {
-                found.push(self.ids[s as usize]);
-                self.cluster_of[s as usize] = root;
-                // Slots added after the first round own no meeting pairs.
-                if (s as usize) < self.first_late {
-                    let (a, b) = (self.meet_start[s as usize], self.meet_start[s as usize + 1]);
-                    ps.extend_from_slice(&self.meets_of[a as usize..b as usize]);
-                }
-                s = self.next[s as usize];
-                if s == root {
-                    break;
-                }
-            }
-            found.sort_unstable();
-            ps.sort_unstable();
-            let (m0, p0) = (self.order.len() as u32, self.pairs.len() as u32);
-            self.order.extend_from_slice(&found);
-            self.pairs.extend(ps.iter().map(|&p| meets[p as usize]));
-            self.todo.push(Todo {
-                m0,
-                m1: self.order.len() as u32,
-                p0,
-                p1: self.pairs.len() as u32,
-            });
+            self.push_cluster(root, meets);
         }
         roots.clear();
         self.dirty_roots = roots;
@@ -520,8 +519,13 @@ impl Rounds {
                 let mut root = NONE;
                 let mut twice = false;
                 for m in members {
-                    let s = match self.slot[m.id as usize] {
-                        NONE => self.add_slot(m.id),
+                    // The run read the slot when it began; one it took in
+                    // may have got one from an earlier run of this round.
+                    let s = match m.slot {
+                        NONE => match self.slot[m.id as usize] {
+                            NONE => self.add_slot(m.id),
+                            s => s,
+                        },
                         s => s,
                     };
                     // Taken in by an earlier run of this round too: the two
