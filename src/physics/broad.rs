@@ -19,11 +19,11 @@ const KEY_BLOCK: usize = 2048;
 /// Coarse-level spheres per parallel block of cross-level queries.
 const CROSS_BLOCK: usize = 64;
 /// Fewer spheres than this are sorted into the first level on one lane.
-const LANES_MIN_SPHERES: usize = 16_384;
+const LANES_MIN_SPHERES: usize = 4096;
 /// Spheres per parallel block while binning.
 const BUILD_BLOCK: usize = 4096;
 /// The first level's cell comes from every this-many-th reach.
-const SAMPLE_STRIDE: usize = 8;
+const SAMPLE_STRIDE: usize = 32;
 const _: () = assert!(BUILD_BLOCK.is_multiple_of(SAMPLE_STRIDE));
 
 /// A sphere's ball for the step: it stays within `reach` of `pos`.
