@@ -99,6 +99,8 @@ pub(super) struct Rounds {
     meets_of: Vec<u32>,
     /// By meeting pair: the slot of its first sphere.
     meet_slot: Vec<u32>,
+    /// Set by `merge_all`: the next partition is one cluster of everyone.
+    whole: bool,
     /// Scratch for one cluster's members and pairs.
     found: Vec<u32>,
     ps: Vec<u32>,
@@ -204,6 +206,10 @@ impl Rounds {
             };
             self.run_clusters(lanes, &sh, absorb);
             self.collect();
+            // One run held everyone with events: nobody is left to meet.
+            if absorb {
+                break;
+            }
             // Paths are compared once the runs agree, not every round; the
             // grown balls (a grid over all of them) once the noted pairs agree.
             if self.conflicts.is_empty() {
@@ -343,6 +349,7 @@ impl Rounds {
             self.dirty[0] = true;
             self.dirty_roots.push(0);
         }
+        self.whole = true;
     }
 
     /// This round's clusters (named by root slot) and the ones that must
@@ -351,10 +358,38 @@ impl Rounds {
     /// dirty, found through their cycles.
     fn partition(&mut self, meets: &[(u32, u32)]) {
         self.todo.clear();
-        if self.stats.rounds == 0 {
+        if self.whole {
+            self.partition_whole(meets);
+        } else if self.stats.rounds == 0 {
             self.partition_all(meets);
         } else {
             self.partition_dirty(meets);
+        }
+    }
+
+    /// Everyone in one cluster (after `merge_all`): the members are the
+    /// slots in sphere order and the pairs all of them, as detected.
+    fn partition_whole(&mut self, meets: &[(u32, u32)]) {
+        self.whole = false;
+        self.dirty_roots.clear();
+        let m = self.ids.len();
+        self.cluster_of.clear();
+        self.cluster_of.resize(m, 0);
+        self.order.clear();
+        self.order.extend_from_slice(&self.ids);
+        if m > self.first_late {
+            // Slots added after the first round are not in sphere order.
+            self.order.sort_unstable();
+        }
+        self.pairs.clear();
+        self.pairs.extend_from_slice(meets);
+        if m > 0 {
+            self.todo.push(Todo {
+                m0: 0,
+                m1: m as u32,
+                p0: 0,
+                p1: meets.len() as u32,
+            });
         }
     }
 
