@@ -3,26 +3,16 @@
 //! before timing). `cargo bench --bench exact`; the accuracy figures (energy
 //! drift over 10 million collisions, deepest overlap, escapes) print first.
 use ballpit::physics::exact::Exact;
-use ballpit::physics::exact::lattice::lattice_world;
+use ballpit::physics::exact::lattice;
 use ballpit::physics::{Model, Serial, World};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::time::{Duration, Instant};
 
 const N: usize = 4000;
 
-/// A melted start (about 20 collisions per sphere from the lattice) and a
-/// step that holds about 40 000 collisions.
+/// A melted start and a step that holds about 40 000 collisions.
 fn melted(packing: f64) -> (World, Exact, f64) {
-    let mut w = lattice_world(N, packing, 1.0, 42).unwrap();
-    let mut m = Exact::default();
-    while w.counters.sphere_collisions < 10 * N as u64 {
-        m.advance(&mut w, 0.01, 1, &Serial);
-    }
-    let (c0, t0) = (w.counters.sphere_collisions, w.time);
-    m.advance(&mut w, 0.01, 5, &Serial);
-    let rate = (w.counters.sphere_collisions - c0) as f64 / (w.time - t0);
-    w.counters = Default::default();
-    (w, m, 40_000.0 / rate)
+    lattice::melted(N, packing, 40_000.0).unwrap()
 }
 
 fn accuracy_report() {

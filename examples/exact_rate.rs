@@ -4,8 +4,7 @@
 //! counts only the event loop; divide by the collisions printed).
 //!
 //! `cargo run --release --example exact_rate -- 0.25 400000`
-use ballpit::physics::exact::Exact;
-use ballpit::physics::exact::lattice::lattice_world;
+use ballpit::physics::exact::lattice::melted;
 use ballpit::physics::{Model, Serial};
 use std::time::Instant;
 
@@ -15,18 +14,9 @@ fn main() {
     let target: u64 = args
         .get(1)
         .map_or(400_000, |a| a.parse().expect("collisions"));
-    let n = 4000;
-    let mut w = lattice_world(n, packing, 1.0, 42).expect("scene");
-    let mut m = Exact::default();
-    while w.counters.sphere_collisions < 10 * n as u64 {
-        m.advance(&mut w, 0.01, 1, &Serial);
-    }
-    let (c0, t0) = (w.counters.sphere_collisions, w.time);
-    m.advance(&mut w, 0.01, 5, &Serial);
-    let rate = (w.counters.sphere_collisions - c0) as f64 / (w.time - t0);
     // Steps of about 40 000 collisions, as in `benches/exact.rs` (a long
     // step could hit the event cap).
-    let dt = 40_000.0 / rate;
+    let (mut w, mut m, dt) = melted(4000, packing, 40_000.0).expect("scene");
     let steps = target.div_ceil(40_000);
     let (c0, s0) = (w.counters.sphere_collisions, m.stats);
     let start = Instant::now();

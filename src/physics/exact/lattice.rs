@@ -3,8 +3,9 @@
 //! lattice (up to packing π/6 ≈ 0.52 when N is a cube) with Gaussian
 //! velocities, then the dynamics melts the lattice within a few collisions
 //! per sphere.
+use super::Exact;
 use crate::error::BadInput;
-use crate::physics::{Sphere, World};
+use crate::physics::{Model, Serial, Sphere, World};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_distr::StandardNormal;
@@ -49,4 +50,21 @@ pub fn lattice_world(n: usize, packing: f64, speed: f64, seed: u64) -> Result<Wo
         }
     }
     Ok(World::new(1.0, spheres))
+}
+
+/// The exact benchmark's start: `n` spheres from the lattice, melted by
+/// about 20 collisions per sphere, with the model that melted them (its
+/// schedule warm) and a step that holds about `per_step` collisions. The
+/// counters start from zero.
+pub fn melted(n: usize, packing: f64, per_step: f64) -> Result<(World, Exact, f64), BadInput> {
+    let mut w = lattice_world(n, packing, 1.0, 42)?;
+    let mut m = Exact::default();
+    while w.counters.sphere_collisions < 10 * n as u64 {
+        m.advance(&mut w, 0.01, 1, &Serial);
+    }
+    let (c0, t0) = (w.counters.sphere_collisions, w.time);
+    m.advance(&mut w, 0.01, 5, &Serial);
+    let rate = (w.counters.sphere_collisions - c0) as f64 / (w.time - t0);
+    w.counters = Default::default();
+    Ok((w, m, per_step / rate))
 }
