@@ -353,9 +353,9 @@ impl Rounds {
     }
 
     /// This round's clusters (named by root slot) and the ones that must
-    /// run, with their members and meeting pairs: everyone in the first
-    /// round, grouped by counting sort; later, only the clusters marked
-    /// dirty, found through their cycles.
+    /// run, with their members and meeting pairs: every cluster in the
+    /// first round, only those marked dirty later, each found by walking
+    /// its cycle.
     fn partition(&mut self, meets: &[(u32, u32)]) {
         self.todo.clear();
         if self.whole {
@@ -410,11 +410,8 @@ impl Rounds {
 
     /// Each first-round slot's meeting pairs (as the pair's first sphere).
     fn index_meets(&mut self, meets: &[(u32, u32)]) {
-        let by_slot = self
-            .meet_slot
-            .iter()
-            .zip(0..meets.len() as u32)
-            .map(|(&s, p)| (s, p));
+        debug_assert_eq!(self.meet_slot.len(), meets.len());
+        let by_slot = self.meet_slot.iter().copied().zip(0..);
         group(
             &mut self.meet_start,
             &mut self.meets_of,
@@ -549,8 +546,7 @@ impl Rounds {
             for &(capped, len) in &out.done {
                 let members = &out.members[k..k + len as usize];
                 k += len as usize;
-                // A run that took outsiders in (the absorbing round) has them
-                // as members now.
+                // Spheres a run took in are its members now.
                 let mut root = NONE;
                 let mut twice = false;
                 for m in members {
