@@ -339,16 +339,17 @@ impl Run {
         push_wall(&mut self.heap, &sa, ia, la as u32, t, ca, sh.size, sh.dt);
         let mut found = std::mem::take(&mut self.found);
         found.clear();
+        // Only what is left of the path can meet anyone: the ball around
+        // the rest of it is searched, not the whole step's.
+        let rem = 0.5 * (sh.dt - t);
+        let (q, rq) = (
+            sa.pos + sa.vel * rem,
+            (sa.radius + sa.vel.length() * rem) * REACH_SLACK,
+        );
+        let this = &*self;
         if !absorb && self.ids.len() <= SMALL_RUN {
-            // Only what is left of the path can meet anyone, and members
-            // are few: they are checked one by one with their grown balls,
-            // so the grid is searched only for balls as binned.
-            let rem = 0.5 * (sh.dt - t);
-            let (q, rq) = (
-                sa.pos + sa.vel * rem,
-                (sa.radius + sa.vel.length() * rem) * REACH_SLACK,
-            );
-            let this = &*self;
+            // Members are few: they are checked one by one with their grown
+            // balls, so the grid is searched only for outsiders.
             sh.grid.near_binned(q, rq, &mut |j, pj0, rj| {
                 if this.member(j).is_none() && q.distance_squared(pj0) <= (rq + rj) * (rq + rj) {
                     found.push(j);
@@ -361,17 +362,17 @@ impl Run {
                 }
             }
         } else {
-            let (p0, ra) = (self.centre[la], self.reach[la]);
-            let this = &*self;
             // Outsiders are judged by the ball the grid holds for them: a
-            // run never reads another run's state.
+            // run never reads another run's state. A member grown past its
+            // cap is no longer found through the grid, so `grown` is
+            // checked by hand.
             let mut consider = |j: u32, pj0: DVec3, rj: f64| {
                 let rj = this.member(j).map_or(rj, |l| this.reach[l]);
-                if p0.distance_squared(pj0) <= (ra + rj) * (ra + rj) {
+                if q.distance_squared(pj0) <= (rq + rj) * (rq + rj) {
                     found.push(j);
                 }
             };
-            sh.grid.near(p0, ra, &mut consider);
+            sh.grid.near(q, rq, &mut consider);
             for &g in &this.grown {
                 let lg = g as usize;
                 consider(this.ids[lg], this.centre[lg], this.reach[lg]);
