@@ -2,7 +2,7 @@
 //! sphere-steps per second: a small target for profilers (callgrind counts
 //! the instructions of a step as the difference of two step counts).
 //!
-//! `cargo run --release --example step -- swept 10000 0.005 200 [speed] [threads|sK]`
+//! `cargo run --release --example step -- swept 10000 0.005 200 [speed] [threads|sK] [box]`
 use ballpit::physics::sphere::volume;
 use ballpit::physics::{Exec, ModelKind, Serial};
 use ballpit::scene::{SceneSpec, build_world};
@@ -16,12 +16,16 @@ fn main() {
     let phi: f64 = arg(2, "0.005").parse().expect("packing");
     let steps: u64 = arg(3, "200").parse().expect("steps");
     let speed: f64 = arg(4, "0.5").parse().expect("speed");
-    let radius = (phi / (n as f64 * volume(1.0))).cbrt();
+    // The box (default 1): with the speed in absolute units, a bigger box at
+    // the same packing keeps the spheres and their motion as they are.
+    let size: f64 = arg(6, "1").parse().expect("box");
+    let radius = (phi * size.powi(3) / (n as f64 * volume(1.0))).cbrt();
     let mut world = build_world(&SceneSpec {
         count: Some(n),
         radius: Some(radius),
         speed: Some(speed),
         seed: Some(7),
+        size: Some(size),
         ..Default::default()
     })
     .expect("scene");
