@@ -4,15 +4,24 @@
 use ballpit::physics::sphere::volume;
 use ballpit::physics::{ModelKind, Serial};
 use ballpit::scene::{SceneSpec, build_world};
-use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use criterion::measurement::WallTime;
+use criterion::{
+    BenchmarkGroup, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main,
+};
 use std::time::Duration;
 
-fn step_throughput(c: &mut Criterion) {
-    let mut group = c.benchmark_group("step");
+/// Ten samples of about three seconds: the 100k steps take tens of ms.
+fn short_group<'a>(c: &'a mut Criterion, name: &str) -> BenchmarkGroup<'a, WallTime> {
+    let mut group = c.benchmark_group(name);
     group
         .sample_size(10)
         .measurement_time(Duration::from_secs(3))
         .warm_up_time(Duration::from_secs(1));
+    group
+}
+
+fn step_throughput(c: &mut Criterion) {
+    let mut group = short_group(c, "step");
     for model in [ModelKind::Swept, ModelKind::Discrete] {
         for phi in [0.005, 0.1] {
             for n in [1_000usize, 10_000, 100_000] {
@@ -43,11 +52,7 @@ fn step_throughput(c: &mut Criterion) {
 /// `step`, the spheres shrink as N grows and each collides N^(1/3) times as
 /// often; that ratio includes the extra physics.)
 fn same_spheres(c: &mut Criterion) {
-    let mut group = c.benchmark_group("same_spheres");
-    group
-        .sample_size(10)
-        .measurement_time(Duration::from_secs(3))
-        .warm_up_time(Duration::from_secs(1));
+    let mut group = short_group(c, "same_spheres");
     let (n0, phi) = (10_000usize, 0.005);
     let radius = (phi / (n0 as f64 * volume(1.0))).cbrt();
     for n in [n0, 10 * n0] {
