@@ -317,64 +317,66 @@ impl Level {
         let (balls, ids) = (&self.balls[..], &self.ids[..]);
         let nowhere = (balls.len() - 1) as u32;
         let s = self.side;
-        let mut k = cs[b * KEY_BLOCK] as usize;
+        let lo = cs[b * KEY_BLOCK] as usize;
         let hi = cs[((b + 1) * KEY_BLOCK).min(keys)] as usize;
-        while k < hi {
-            let c = self.keys[k] as usize;
-            let end = cs[c + 1] as usize;
+        // One sphere at a time, its windows looked up afresh: cells hold a
+        // sphere or so, and state kept per cell spilled out of registers.
+        let mine = self.keys[lo..hi]
+            .iter()
+            .zip(&balls[lo..hi])
+            .zip(&ids[lo..hi]);
+        for (i, ((&c, a), &ia)) in (lo..).zip(mine) {
+            let c = c as usize;
             let row_end = cs[c + 2] as usize;
             // Forward rows: (y+1, z), then (y-1..=y+1, z+1); x-1..=x+1 each.
             let (r1, r2) = (c + s - 1, c + s * s - s - 1);
-            let (r3, r4) = (r2 + s, r2 + 2 * s);
+            let w1 = &cs[r1..r1 + 4];
+            let w2 = &cs[r2..r2 + 2 * s + 4];
             let windows = [
-                (cs[r1] as usize, cs[r1 + 3] as usize),
-                (cs[r2] as usize, cs[r2 + 3] as usize),
-                (cs[r3] as usize, cs[r3 + 3] as usize),
-                (cs[r4] as usize, cs[r4 + 3] as usize),
+                (w1[0] as usize, w1[3] as usize),
+                (w2[0] as usize, w2[3] as usize),
+                (w2[s] as usize, w2[s + 3] as usize),
+                (w2[2 * s] as usize, w2[2 * s + 3] as usize),
             ];
-            for i in k..end {
-                let (a, ia) = (&balls[i], ids[i]);
-                // Nearly every window holds at most a few spheres, so copy
-                // four indices from each unconditionally and count only the
-                // real ones, then test the candidates four at a time, padded
-                // with `NOWHERE`: a loop that nearly always runs once, where
-                // five short loops had exits the branch predictor could not
-                // guess.
-                let mut buf = [nowhere; 4 * 6];
-                let mut len = 0;
-                let mut wide = false;
-                let mut gather = |lo: usize, hi: usize| {
-                    let l = lo as u32;
-                    buf[len..len + 4].copy_from_slice(&[l, l + 1, l + 2, l + 3]);
-                    len += (hi - lo).min(4);
-                    wide |= hi - lo > 4;
-                };
-                gather(i + 1, row_end);
-                gather(windows[0].0, windows[0].1);
-                gather(windows[1].0, windows[1].1);
-                gather(windows[2].0, windows[2].1);
-                gather(windows[3].0, windows[3].1);
-                buf[len..len + 4].copy_from_slice(&[nowhere; 4]);
-                if wide {
-                    scan(a, ia, &balls[i + 1..row_end], &ids[i + 1..row_end], f);
-                    for (lo, hi) in windows {
-                        scan(a, ia, &balls[lo..hi], &ids[lo..hi], f);
-                    }
-                } else {
-                    for four in buf[..len.next_multiple_of(4)].chunks_exact(4) {
-                        let near = |j: u32| within(a, &balls[j as usize]);
-                        // `|`, not `||`: all four tested without branches.
-                        if near(four[0]) | near(four[1]) | near(four[2]) | near(four[3]) {
-                            for &j in four {
-                                if near(j) {
-                                    f(ia, ids[j as usize]);
-                                }
+            // Nearly every window holds at most a few spheres, so copy
+            // four indices from each unconditionally and count only the
+            // real ones, then test the candidates four at a time, padded
+            // with `NOWHERE`: a loop that nearly always runs once, where
+            // five short loops had exits the branch predictor could not
+            // guess.
+            let mut buf = [nowhere; 4 * 6];
+            let mut len = 0;
+            let mut wide = false;
+            let mut gather = |lo: usize, hi: usize| {
+                let l = lo as u32;
+                buf[len..len + 4].copy_from_slice(&[l, l + 1, l + 2, l + 3]);
+                len += (hi - lo).min(4);
+                wide |= hi - lo > 4;
+            };
+            gather(i + 1, row_end);
+            gather(windows[0].0, windows[0].1);
+            gather(windows[1].0, windows[1].1);
+            gather(windows[2].0, windows[2].1);
+            gather(windows[3].0, windows[3].1);
+            buf[len..len + 4].copy_from_slice(&[nowhere; 4]);
+            if wide {
+                scan(a, ia, &balls[i + 1..row_end], &ids[i + 1..row_end], f);
+                for (lo, hi) in windows {
+                    scan(a, ia, &balls[lo..hi], &ids[lo..hi], f);
+                }
+            } else {
+                for four in buf[..len.next_multiple_of(4)].chunks_exact(4) {
+                    let near = |j: u32| within(a, &balls[j as usize]);
+                    // `|`, not `||`: all four tested without branches.
+                    if near(four[0]) | near(four[1]) | near(four[2]) | near(four[3]) {
+                        for &j in four {
+                            if near(j) {
+                                f(ia, ids[j as usize]);
                             }
                         }
                     }
                 }
             }
-            k = end;
         }
     }
 
