@@ -380,6 +380,26 @@ impl Level {
         }
     }
 
+    /// Indices of the spheres in the cells on the faces of the box.
+    fn on_faces(&self, f: &mut impl FnMut(usize)) {
+        if self.ids.is_empty() {
+            return;
+        }
+        let (last, s, cs) = (self.per_side - 1, self.side, &self.cell_start);
+        let key = |x: usize, y: usize, z: usize| (x + 1) + s * ((y + 1) + s * (z + 1));
+        for z in 0..=last {
+            for y in 0..=last {
+                let (a, b) = (key(0, y, z), key(last, y, z));
+                if z == 0 || z == last || y == 0 || y == last {
+                    (cs[a] as usize..cs[b + 1] as usize).for_each(&mut *f);
+                } else {
+                    (cs[a] as usize..cs[a + 1] as usize).for_each(&mut *f);
+                    (cs[b] as usize..cs[b + 1] as usize).for_each(&mut *f);
+                }
+            }
+        }
+    }
+
     /// Indices of the spheres in the cells covering `p ± span`.
     fn near(&self, p: DVec3, span: f64, f: &mut impl FnMut(usize)) {
         if self.ids.is_empty() {
@@ -669,6 +689,19 @@ impl Grid {
         }
         for (b, id) in &self.top {
             f(*id, b.pos, b.reach);
+        }
+    }
+
+    /// Every sphere whose ball may reach a face of the box the grid was
+    /// built for, as `f(id)`, in no particular order: those in the cells on
+    /// the faces, and the last few. A ball is at most half a cell wide, so
+    /// from any other cell it stays over half a cell inside.
+    pub fn near_faces(&self, f: &mut impl FnMut(u32)) {
+        for level in &self.levels {
+            level.on_faces(&mut |j| f(level.ids[j]));
+        }
+        for (_, id) in &self.top {
+            f(*id);
         }
     }
 

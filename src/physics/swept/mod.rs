@@ -189,11 +189,19 @@ impl Swept {
     fn detect(&mut self, world: &World, dt: f64, exec: &dyn Exec) -> f64 {
         let size = world.size;
         let sp = &world.spheres;
+        // Walls come from the grid: only a sphere in a cell on a face can
+        // reach one, and most are not.
         self.detect
-            .run(exec, sp, size, |s| path_ball(s, dt), &|_, _| true, &|s| {
-                reaches_wall(s, size, dt)
+            .run(exec, sp, size, |s| path_ball(s, dt), &|_, _| true, &|_| {
+                false
             });
-        self.detect.wall_hits(&mut self.hits);
+        self.hits.clear();
+        let hits = &mut self.hits;
+        self.detect.grid.near_faces(&mut |i| {
+            if reaches_wall(&sp[i as usize], size, dt) {
+                hits.push(i);
+            }
+        });
         self.sort_pairs(sp, dt, exec)
     }
 
