@@ -87,6 +87,8 @@ pub struct Grid {
     /// The last few, tested against everything.
     top: Vec<(Ball, u32)>,
     staged: Vec<Staged>,
+    /// The box's side, as of the last build.
+    size: f64,
     /// Spheres not yet placed in a level: (ball, id).
     rest: Vec<(Ball, u32)>,
     scratch: Vec<f64>,
@@ -478,6 +480,7 @@ impl Grid {
         exec: &dyn Exec,
     ) {
         let n = spheres.len();
+        self.size = size;
         self.top.clear();
         self.staged.resize(n, Staged::default());
         let blocks = n.div_ceil(BUILD_BLOCK);
@@ -692,16 +695,28 @@ impl Grid {
         }
     }
 
-    /// Every sphere whose ball may reach a face of the box the grid was
-    /// built for, as `f(id)`, in no particular order: those in the cells on
-    /// the faces, and the last few. A ball is at most half a cell wide, so
-    /// from any other cell it stays over half a cell inside.
+    /// Every sphere whose ball reaches a face of the box the grid was built
+    /// for, as `f(id)`, in no particular order. Only the cells on the faces
+    /// and the last few are looked at: a ball is at most half a cell wide,
+    /// so from any other cell it stays over half a cell inside.
     pub fn near_faces(&self, f: &mut impl FnMut(u32)) {
+        let size = self.size;
+        let out = |b: &Ball| {
+            (b.pos.min_element() - b.reach <= 0.0) | (b.pos.max_element() + b.reach >= size)
+        };
         for level in &self.levels {
-            level.on_faces(&mut |j| f(level.ids[j]));
+            level.on_faces(&mut |j| {
+                // The balls lie in cell order, so this test reads memory in
+                // order; the caller's test, for the few that pass, does not.
+                if out(&level.balls[j]) {
+                    f(level.ids[j])
+                }
+            });
         }
-        for (_, id) in &self.top {
-            f(*id);
+        for (b, id) in &self.top {
+            if out(b) {
+                f(*id);
+            }
         }
     }
 
