@@ -347,13 +347,12 @@ impl Level {
             // five short loops had exits the branch predictor could not
             // guess.
             let mut buf = [nowhere; 4 * 6];
-            let mut len = 0;
-            let mut wide = false;
+            let (mut len, mut all) = (0, 0);
             let mut gather = |lo: usize, hi: usize| {
                 let l = lo as u32;
                 buf[len..len + 4].copy_from_slice(&[l, l + 1, l + 2, l + 3]);
                 len += (hi - lo).min(4);
-                wide |= hi - lo > 4;
+                all += hi - lo;
             };
             gather(i + 1, row_end);
             gather(windows[0].0, windows[0].1);
@@ -361,7 +360,8 @@ impl Level {
             gather(windows[2].0, windows[2].1);
             gather(windows[3].0, windows[3].1);
             buf[len..len + 4].copy_from_slice(&[nowhere; 4]);
-            if wide {
+            // Some window held more than four.
+            if all != len {
                 scan(a, ia, &balls[i + 1..row_end], &ids[i + 1..row_end], f);
                 for (lo, hi) in windows {
                     scan(a, ia, &balls[lo..hi], &ids[lo..hi], f);

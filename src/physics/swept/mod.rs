@@ -47,19 +47,8 @@ pub struct Swept {
     /// Per block of candidate pairs: the deepest overlap among them.
     overlap: Vec<Mutex<f64>>,
     rounds: Rounds,
-    /// Per block of spheres: what its spheres' events added up to.
-    tallies: Vec<Mutex<Tally>>,
     /// Detection already made for the next step of the world it names.
     ahead: Option<Ahead>,
-}
-
-/// One block of spheres' share of a step's counters.
-#[derive(Clone, Copy, Debug, Default)]
-struct Tally {
-    momentum: f64,
-    pairs: u64,
-    walls: u64,
-    capped: bool,
 }
 
 /// A detection made ahead of its step (when the engine asked for the
@@ -150,36 +139,22 @@ impl Swept {
             &self.near,
             &self.hits,
         );
-        // Spheres with events take their run's end; everyone else flies
-        // straight and meets no wall. The tallies are summed per block in
-        // sphere order, then block by block: the same bits on any lanes.
-        let blocks = world.spheres.len().div_ceil(SPHERE_BLOCK);
-        self.tallies.resize_with(blocks, Default::default);
-        let (rounds, tallies) = (&self.rounds, &self.tallies);
-        for_each_chunk(exec, &mut world.spheres, SPHERE_BLOCK, &|b, chunk| {
-            let mut tally = Tally::default();
-            for (k, s) in chunk.iter_mut().enumerate() {
-                match rounds.result(b * SPHERE_BLOCK + k) {
-                    Some((m, capped)) => {
-                        *s = m.sphere;
-                        tally.momentum += m.wall_momentum;
-                        tally.pairs += u64::from(m.pair_hits);
-                        tally.walls += u64::from(m.wall_hits);
-                        tally.capped |= capped;
-                    }
-                    None => s.pos += s.vel * dt,
-                }
+        // Everyone flies straight; then the spheres with events take their
+        // run's end, and the counters are summed in slot order: the same
+        // bits on any lanes.
+        for_each_chunk(exec, &mut world.spheres, SPHERE_BLOCK, &|_, chunk| {
+            for s in chunk {
+                s.pos += s.vel * dt;
             }
-            *tallies[b].lock() = tally;
         });
         let c = &mut world.counters;
         let mut capped = false;
-        for t in &self.tallies[..blocks] {
-            let t = *t.lock();
-            c.wall_momentum += t.momentum;
-            c.sphere_collisions += t.pairs;
-            c.wall_collisions += t.walls;
-            capped |= t.capped;
+        for (m, cap) in self.rounds.results() {
+            world.spheres[m.id as usize] = m.sphere;
+            c.wall_momentum += m.wall_momentum;
+            c.sphere_collisions += u64::from(m.pair_hits);
+            c.wall_collisions += u64::from(m.wall_hits);
+            capped |= cap;
         }
         c.capped_steps += u64::from(capped);
     }

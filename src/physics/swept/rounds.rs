@@ -135,25 +135,20 @@ pub(super) struct Rounds {
 }
 
 impl Rounds {
-    /// Sphere `i`'s result of the last `run` (and whether its run hit the
-    /// event cap), if it had events.
-    #[inline]
-    pub fn result(&self, i: usize) -> Option<(&Member, bool)> {
-        match self.slot[i] {
-            NONE => None,
-            s => Some((
-                self.out[s as usize]
-                    .as_ref()
-                    .expect("every involved sphere finished"),
-                self.capped[s as usize],
-            )),
-        }
+    /// The results of the last `run`: every sphere that had events, with
+    /// its run's end of the step and whether the run hit the event cap, in
+    /// a fixed order (by slot).
+    pub fn results(&self) -> impl Iterator<Item = (&Member, bool)> {
+        self.out
+            .iter()
+            .zip(&self.capped)
+            .map(|(m, &capped)| (m.as_ref().expect("every involved sphere finished"), capped))
     }
 
     /// Runs the events of a step: `meets` are the pairs whose straight paths
     /// meet within `dt`, `near` pairs whose balls overlap but do not meet,
     /// `hits` the spheres that reach a wall. Each involved sphere's end of
-    /// the step is then its [`Rounds::result`]; `spheres` is not changed.
+    /// the step is then among [`Rounds::results`]; `spheres` is not changed.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &mut self,
