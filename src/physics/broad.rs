@@ -40,11 +40,13 @@ struct Ball {
     reach: f64,
 }
 
-/// A sphere on its way into the first level: its ball and padded cell key
-/// (`u32::MAX`: too wide for the level).
+/// A sphere in a level: its ball, id and padded cell key (on its way into
+/// the first level, `u32::MAX` when too wide for it). One record, so that
+/// sorting it into place writes one place in memory, not three.
 #[derive(Clone, Copy, Debug, Default)]
-struct Staged {
+struct Entry {
     ball: Ball,
+    id: u32,
     key: u32,
 }
 
@@ -71,12 +73,8 @@ struct Level {
     inv_cell: f64,
     cell: f64,
     cell_start: Vec<u32>,
-    /// The spheres of this level sorted by cell key, as three parallel
-    /// arrays: the pair loops read the balls of every candidate but the id
-    /// only of the few within reach.
-    balls: Vec<Ball>,
-    ids: Vec<u32>,
-    keys: Vec<u32>,
+    /// The spheres of this level sorted by cell key, then a `NOWHERE` pad.
+    entries: Vec<Entry>,
     /// Largest reach in this level.
     reach_max: f64,
 }
@@ -86,7 +84,7 @@ pub struct Grid {
     levels: Vec<Level>,
     /// The last few, tested against everything.
     top: Vec<(Ball, u32)>,
-    staged: Vec<Staged>,
+    staged: Vec<Entry>,
     /// The box's side, as of the last build.
     size: f64,
     /// Spheres not yet placed in a level: (ball, id).
@@ -138,13 +136,14 @@ fn cell_of_sample(scratch: &mut [f64], max: f64) -> f64 {
 
 /// Room for `n` entries and the `NOWHERE` pad; the old contents stay (the
 /// scatter writes every slot), so no serial pass clears them. Takes the
-/// fields, not the level, so it can run while the cell table is lent out.
-fn room(balls: &mut Vec<Ball>, ids: &mut Vec<u32>, keys: &mut Vec<u32>, n: usize) {
-    balls.truncate(n);
-    balls.resize(n, Ball::default());
-    balls.push(NOWHERE);
-    ids.resize(n, 0);
-    keys.resize(n, 0);
+/// entries, not the level, so it can run while the cell table is lent out.
+fn room(entries: &mut Vec<Entry>, n: usize) {
+    entries.truncate(n);
+    entries.resize(n, Entry::default());
+    entries.push(Entry {
+        ball: NOWHERE,
+        ..Entry::default()
+    });
 }
 
 impl Level {
@@ -184,10 +183,10 @@ impl Level {
     /// to `cell_start[key]`, inclusive prefix sums make that the end of each
     /// cell, and placing the items in reverse order walks each end down to
     /// the cell's start.
-    fn fill(&mut self, items: &[(Ball, u32, u32)]) {
-        for &(b, _, key) in items {
-            self.reach_max = self.reach_max.max(b.reach);
-            self.cell_start[key as usize] += 1;
+    fn fill(&mut self, items: &[Entry]) {
+        for e in items {
+            self.reach_max = self.reach_max.max(e.ball.reach);
+            self.cell_start[e.key as usize] += 1;
         }
         let cells = self.cell_start.len() - 1;
         let mut sum = 0;
@@ -196,14 +195,11 @@ impl Level {
             *c = sum;
         }
         self.cell_start[cells] = sum;
-        room(&mut self.balls, &mut self.ids, &mut self.keys, sum as usize);
-        for &(b, id, key) in items.iter().rev() {
-            let slot = &mut self.cell_start[key as usize];
+        room(&mut self.entries, sum as usize);
+        for e in items.iter().rev() {
+            let slot = &mut self.cell_start[e.key as usize];
             *slot -= 1;
-            let at = *slot as usize;
-            self.balls[at] = b;
-            self.ids[at] = id;
-            self.keys[at] = key;
+            self.entries[*slot as usize] = *e;
         }
     }
 
@@ -212,7 +208,7 @@ impl Level {
     /// places only the keys of its range, into its own part of the cell
     /// table and of the entries, so the layout is the same for any number
     /// of lanes.
-    fn fill_lanes(&mut self, staged: &[Staged], exec: &dyn Exec) {
+    fn fill_lanes(&mut self, staged: &[Entry], exec: &dyn Exec) {
         let cells = self.cell_start.len() - 1;
         // Under this many spheres, waking other threads costs more than the
         // sort; the layout is the same for any number of lanes.
@@ -262,21 +258,13 @@ impl Level {
             self.reach_max = self.reach_max.max(reach_max);
         }
         offsets.push(sum);
-        room(&mut self.balls, &mut self.ids, &mut self.keys, sum as usize);
-        type Region<'a> = Mutex<(&'a mut [Ball], &'a mut [u32], &'a mut [u32])>;
-        let mut regions: Vec<Region> = Vec::with_capacity(lanes);
-        let (mut balls, mut ids, mut keys) = (
-            &mut self.balls[..sum as usize],
-            &mut self.ids[..],
-            &mut self.keys[..],
-        );
+        room(&mut self.entries, sum as usize);
+        let mut regions: Vec<Mutex<&mut [Entry]>> = Vec::with_capacity(lanes);
+        let mut rest = &mut self.entries[..sum as usize];
         for l in 0..lanes {
-            let len = (offsets[l + 1] - offsets[l]) as usize;
-            let (b, more_b) = balls.split_at_mut(len);
-            let (i, more_i) = ids.split_at_mut(len);
-            let (k, more_k) = keys.split_at_mut(len);
-            regions.push(Mutex::new((b, i, k)));
-            (balls, ids, keys) = (more_b, more_i, more_k);
+            let (mine, more) = rest.split_at_mut((offsets[l + 1] - offsets[l]) as usize);
+            regions.push(Mutex::new(mine));
+            rest = more;
         }
         exec.for_each_lane(&|l| {
             if l >= lanes {
@@ -290,15 +278,11 @@ impl Level {
                 *c = end;
             }
             let mut region = regions[l].lock();
-            let (balls, ids, keys) = &mut *region;
-            for (i, s) in staged.iter().enumerate().rev() {
+            for s in staged.iter().rev() {
                 if s.key >= lo && s.key < hi {
                     let slot = &mut table[(s.key - lo) as usize];
                     *slot -= 1;
-                    let at = (*slot - offsets[l]) as usize;
-                    balls[at] = s.ball;
-                    ids[at] = i as u32;
-                    keys[at] = s.key;
+                    region[(*slot - offsets[l]) as usize] = *s;
                 }
             }
         });
@@ -316,19 +300,15 @@ impl Level {
     fn block_pairs(&self, b: usize, f: &mut impl FnMut(u32, u32)) {
         let keys = self.cell_start.len() - 1;
         let cs = &self.cell_start[..];
-        let (balls, ids) = (&self.balls[..], &self.ids[..]);
-        let nowhere = (balls.len() - 1) as u32;
+        let entries = &self.entries[..];
+        let nowhere = (entries.len() - 1) as u32;
         let s = self.side;
         let lo = cs[b * KEY_BLOCK] as usize;
         let hi = cs[((b + 1) * KEY_BLOCK).min(keys)] as usize;
         // One sphere at a time, its windows looked up afresh: cells hold a
         // sphere or so, and state kept per cell spilled out of registers.
-        let mine = self.keys[lo..hi]
-            .iter()
-            .zip(&balls[lo..hi])
-            .zip(&ids[lo..hi]);
-        for (i, ((&c, a), &ia)) in (lo..).zip(mine) {
-            let c = c as usize;
+        for (i, e) in (lo..).zip(&entries[lo..hi]) {
+            let (c, a, ia) = (e.key as usize, &e.ball, e.id);
             let row_end = cs[c + 2] as usize;
             // Forward rows: (y+1, z), then (y-1..=y+1, z+1); x-1..=x+1 each.
             let (r1, r2) = (c + s - 1, c + s * s - s - 1);
@@ -362,18 +342,18 @@ impl Level {
             buf[len..len + 4].copy_from_slice(&[nowhere; 4]);
             // Some window held more than four.
             if all != len {
-                scan(a, ia, &balls[i + 1..row_end], &ids[i + 1..row_end], f);
+                scan(a, ia, &entries[i + 1..row_end], f);
                 for (lo, hi) in windows {
-                    scan(a, ia, &balls[lo..hi], &ids[lo..hi], f);
+                    scan(a, ia, &entries[lo..hi], f);
                 }
             } else {
                 for four in buf[..len.next_multiple_of(4)].chunks_exact(4) {
-                    let near = |j: u32| within(a, &balls[j as usize]);
+                    let near = |j: u32| within(a, &entries[j as usize].ball);
                     // `|`, not `||`: all four tested without branches.
                     if near(four[0]) | near(four[1]) | near(four[2]) | near(four[3]) {
                         for &j in four {
                             if near(j) {
-                                f(ia, ids[j as usize]);
+                                f(ia, entries[j as usize].id);
                             }
                         }
                     }
@@ -384,7 +364,7 @@ impl Level {
 
     /// Indices of the spheres in the cells on the faces of the box.
     fn on_faces(&self, f: &mut impl FnMut(usize)) {
-        if self.ids.is_empty() {
+        if self.entries.len() <= 1 {
             return;
         }
         let (last, s, cs) = (self.per_side - 1, self.side, &self.cell_start);
@@ -404,7 +384,7 @@ impl Level {
 
     /// Indices of the spheres in the cells covering `p ± span`.
     fn near(&self, p: DVec3, span: f64, f: &mut impl FnMut(usize)) {
-        if self.ids.is_empty() {
+        if self.entries.len() <= 1 {
             return;
         }
         let last = self.per_side - 1;
@@ -442,12 +422,12 @@ fn within(a: &Ball, b: &Ball) -> bool {
     (a.pos - b.pos).length_squared() <= s * s
 }
 
-/// `f(ia, id)` for each of `balls` (with `ids`) within reach of `a`.
+/// `f(ia, id)` for each of `entries` within reach of `a`.
 #[inline(always)]
-fn scan(a: &Ball, ia: u32, balls: &[Ball], ids: &[u32], f: &mut impl FnMut(u32, u32)) {
-    for (b, id) in balls.iter().zip(ids) {
-        if within(a, b) {
-            f(ia, *id);
+fn scan(a: &Ball, ia: u32, entries: &[Entry], f: &mut impl FnMut(u32, u32)) {
+    for e in entries {
+        if within(a, &e.ball) {
+            f(ia, e.id);
         }
     }
 }
@@ -482,15 +462,21 @@ impl Grid {
         let n = spheres.len();
         self.size = size;
         self.top.clear();
-        self.staged.resize(n, Staged::default());
+        self.staged.resize(n, Entry::default());
         let blocks = n.div_ceil(BUILD_BLOCK);
         self.block_max.resize_with(blocks, Default::default);
         let block_max = &self.block_max;
         for_each_chunk(exec, &mut self.staged, BUILD_BLOCK, &|b, chunk| {
             let mut max: f64 = 0.0;
-            for (slot, s) in chunk.iter_mut().zip(&spheres[b * BUILD_BLOCK..]) {
+            let first = (b * BUILD_BLOCK) as u32;
+            for ((slot, s), id) in chunk
+                .iter_mut()
+                .zip(&spheres[b * BUILD_BLOCK..])
+                .zip(first..)
+            {
                 let (pos, reach) = ball(s);
                 slot.ball = Ball { pos, reach };
+                slot.id = id;
                 if reach > max {
                     max = reach;
                 }
@@ -554,11 +540,15 @@ impl Grid {
                 );
                 let level = &mut self.levels[depth];
                 level.shape(size, want, self.rest.len(), false);
-                let placed: Vec<(Ball, u32, u32)> = self
+                let placed: Vec<Entry> = self
                     .rest
                     .iter()
                     .filter(|b| level.fits(b.0.reach))
-                    .map(|&(b, id)| (b, id, level.key_of(b.pos)))
+                    .map(|&(ball, id)| Entry {
+                        ball,
+                        id,
+                        key: level.key_of(ball.pos),
+                    })
                     .collect();
                 if placed.is_empty() {
                     // Balls wider than a one-cell level (the whole box) fit
@@ -588,7 +578,7 @@ impl Grid {
         for (l, level) in self.levels.iter().enumerate() {
             units.extend((0..level.key_blocks()).map(|block| Unit::Block { level: l, block }));
             if l > 0 {
-                let n = level.ids.len();
+                let n = level.entries.len() - 1;
                 units.extend((0..n.div_ceil(CROSS_BLOCK)).map(|b| Unit::Cross {
                     level: l,
                     from: b * CROSS_BLOCK,
@@ -608,11 +598,13 @@ impl Grid {
             Unit::Block { level, block } => self.levels[level].block_pairs(block, f),
             Unit::Cross { level, from, to } => {
                 let coarse = &self.levels[level];
-                for (a, &ia) in coarse.balls[from..to].iter().zip(&coarse.ids[from..to]) {
+                for e in &coarse.entries[from..to] {
+                    let (a, ia) = (&e.ball, e.id);
                     for finer in &self.levels[..level] {
                         finer.near(a.pos, a.reach + finer.reach_max, &mut |j| {
-                            if within(a, &finer.balls[j]) {
-                                f(ia, finer.ids[j]);
+                            let b = &finer.entries[j];
+                            if within(a, &b.ball) {
+                                f(ia, b.id);
                             }
                         });
                     }
@@ -622,8 +614,9 @@ impl Grid {
                 for (k, (a, ia)) in self.top.iter().enumerate() {
                     for level in &self.levels {
                         level.near(a.pos, a.reach + level.reach_max, &mut |j| {
-                            if within(a, &level.balls[j]) {
-                                f(*ia, level.ids[j]);
+                            let b = &level.entries[j];
+                            if within(a, &b.ball) {
+                                f(*ia, b.id);
                             }
                         });
                     }
@@ -671,8 +664,8 @@ impl Grid {
     pub fn near(&self, p: DVec3, reach: f64, f: &mut impl FnMut(u32, DVec3, f64)) {
         for level in &self.levels {
             level.near(p, reach + GROWTH_CAP * level.reach_max, &mut |j| {
-                let b = &level.balls[j];
-                f(level.ids[j], b.pos, b.reach)
+                let e = &level.entries[j];
+                f(e.id, e.ball.pos, e.ball.reach)
             });
         }
         for (b, id) in &self.top {
@@ -686,8 +679,8 @@ impl Grid {
     pub fn near_binned(&self, p: DVec3, reach: f64, f: &mut impl FnMut(u32, DVec3, f64)) {
         for level in &self.levels {
             level.near(p, reach + level.reach_max, &mut |j| {
-                let b = &level.balls[j];
-                f(level.ids[j], b.pos, b.reach)
+                let e = &level.entries[j];
+                f(e.id, e.ball.pos, e.ball.reach)
             });
         }
         for (b, id) in &self.top {
@@ -708,8 +701,9 @@ impl Grid {
             level.on_faces(&mut |j| {
                 // The balls lie in cell order, so this test reads memory in
                 // order; the caller's test, for the few that pass, does not.
-                if out(&level.balls[j]) {
-                    f(level.ids[j])
+                let e = &level.entries[j];
+                if out(&e.ball) {
+                    f(e.id)
                 }
             });
         }
@@ -735,7 +729,7 @@ impl Grid {
         (
             self.levels
                 .iter()
-                .map(|l| (l.per_side, l.ids.len()))
+                .map(|l| (l.per_side, l.entries.len().saturating_sub(1)))
                 .collect(),
             self.top.len(),
         )
