@@ -70,6 +70,8 @@ struct Level {
     per_side: usize,
     /// Padded cells per side (`per_side + 2`).
     side: usize,
+    /// The last real cell's coordinate, `per_side - 1`.
+    top: f64,
     inv_cell: f64,
     cell: f64,
     cell_start: Vec<u32>,
@@ -98,12 +100,12 @@ pub struct Grid {
     slots: Vec<Mutex<Vec<Pair>>>,
 }
 
-/// Real cell coordinates of `p`, clamped into `0..=last`. Truncation is
+/// Real cell coordinates of `p`, clamped into `0..=top`. Truncation is
 /// floor here (after max(0)), without a libm call; clamping in floating
-/// point first (NaN goes to 0) lets the cast be a 32-bit one.
+/// point first (NaN goes to 0) lets the cast be a 32-bit one. `top` comes
+/// as a float: converting it here cost as much as the rest.
 #[inline]
-fn cell_coords(p: DVec3, inv_cell: f64, last: usize) -> [usize; 3] {
-    let top = last as f64;
+fn cell_coords(p: DVec3, inv_cell: f64, top: f64) -> [usize; 3] {
     let c = |x: f64| (x * inv_cell).max(0.0).min(top) as u32 as usize;
     [c(p.x), c(p.y), c(p.z)]
 }
@@ -158,6 +160,7 @@ impl Level {
         self.side = self.per_side + 2;
         self.cell = size / self.per_side as f64;
         self.inv_cell = 1.0 / self.cell;
+        self.top = (self.per_side - 1) as f64;
         self.reach_max = 0.0;
         let len = self.side * self.side * self.side + 1;
         if lanes_zero {
@@ -175,7 +178,7 @@ impl Level {
 
     #[inline]
     fn key_of(&self, p: DVec3) -> u32 {
-        let [x, y, z] = cell_coords(p, self.inv_cell, self.per_side - 1);
+        let [x, y, z] = cell_coords(p, self.inv_cell, self.top);
         ((x + 1) + self.side * ((y + 1) + self.side * (z + 1))) as u32
     }
 
@@ -302,63 +305,71 @@ impl Level {
         let cs = &self.cell_start[..];
         let entries = &self.entries[..];
         let nowhere = (entries.len() - 1) as u32;
-        let s = self.side;
         let lo = cs[b * KEY_BLOCK] as usize;
         let hi = cs[((b + 1) * KEY_BLOCK).min(keys)] as usize;
+        // Nearly every window holds at most a few spheres, so four indices
+        // are copied from each unconditionally and only the real ones
+        // counted, then the candidates are tested four at a time, padded
+        // with `NOWHERE`: a loop that nearly always runs once, where five
+        // short loops had exits the branch predictor could not guess. The
+        // buffer lives across spheres: only what a sphere wrote is read.
+        let mut buf = [nowhere; 4 * 6];
         // One sphere at a time, its windows looked up afresh: cells hold a
         // sphere or so, and state kept per cell spilled out of registers.
         for (i, e) in (lo..).zip(&entries[lo..hi]) {
-            let (c, a, ia) = (e.key as usize, &e.ball, e.id);
-            let row_end = cs[c + 2] as usize;
-            // Forward rows: (y+1, z), then (y-1..=y+1, z+1); x-1..=x+1 each.
-            let (r1, r2) = (c + s - 1, c + s * s - s - 1);
-            let w1 = &cs[r1..r1 + 4];
-            let w2 = &cs[r2..r2 + 2 * s + 4];
-            let windows = [
-                (w1[0] as usize, w1[3] as usize),
-                (w2[0] as usize, w2[3] as usize),
-                (w2[s] as usize, w2[s + 3] as usize),
-                (w2[2 * s] as usize, w2[2 * s + 3] as usize),
-            ];
-            // Nearly every window holds at most a few spheres, so copy
-            // four indices from each unconditionally and count only the
-            // real ones, then test the candidates four at a time, padded
-            // with `NOWHERE`: a loop that nearly always runs once, where
-            // five short loops had exits the branch predictor could not
-            // guess.
-            let mut buf = [nowhere; 4 * 6];
+            let (a, ia) = (&e.ball, e.id);
             let (mut len, mut all) = (0, 0);
-            let mut gather = |lo: usize, hi: usize| {
+            for (lo, hi) in self.windows(i, e.key as usize) {
                 let l = lo as u32;
                 buf[len..len + 4].copy_from_slice(&[l, l + 1, l + 2, l + 3]);
                 len += (hi - lo).min(4);
                 all += hi - lo;
-            };
-            gather(i + 1, row_end);
-            gather(windows[0].0, windows[0].1);
-            gather(windows[1].0, windows[1].1);
-            gather(windows[2].0, windows[2].1);
-            gather(windows[3].0, windows[3].1);
+            }
             buf[len..len + 4].copy_from_slice(&[nowhere; 4]);
-            // Some window held more than four.
             if all != len {
-                scan(a, ia, &entries[i + 1..row_end], f);
-                for (lo, hi) in windows {
-                    scan(a, ia, &entries[lo..hi], f);
-                }
-            } else {
-                for four in buf[..len.next_multiple_of(4)].chunks_exact(4) {
-                    let near = |j: u32| within(a, &entries[j as usize].ball);
-                    // `|`, not `||`: all four tested without branches.
-                    if near(four[0]) | near(four[1]) | near(four[2]) | near(four[3]) {
-                        for &j in four {
-                            if near(j) {
-                                f(ia, entries[j as usize].id);
-                            }
+                self.wide_pairs(i, f);
+                continue;
+            }
+            for four in buf[..len.next_multiple_of(4)].chunks_exact(4) {
+                let near = |j: u32| within(a, &entries[j as usize].ball);
+                // `|`, not `||`: all four tested without branches.
+                if near(four[0]) | near(four[1]) | near(four[2]) | near(four[3]) {
+                    for &j in four {
+                        if near(j) {
+                            f(ia, entries[j as usize].id);
                         }
                     }
                 }
             }
+        }
+    }
+
+    /// The entry ranges the pairs of entry `i` (in cell `c`) come from: the
+    /// rest of its row from the next entry on up to the next cell, then the
+    /// forward rows (y+1, z) and (y-1..=y+1, z+1), cells x-1..=x+1 each.
+    #[inline(always)]
+    fn windows(&self, i: usize, c: usize) -> [(usize, usize); 5] {
+        let (cs, s) = (&self.cell_start[..], self.side);
+        let (r1, r2) = (c + s - 1, c + s * s - s - 1);
+        let w1 = &cs[r1..r1 + 4];
+        let w2 = &cs[r2..r2 + 2 * s + 4];
+        [
+            (i + 1, cs[c + 2] as usize),
+            (w1[0] as usize, w1[3] as usize),
+            (w2[0] as usize, w2[3] as usize),
+            (w2[s] as usize, w2[s + 3] as usize),
+            (w2[2 * s] as usize, w2[2 * s + 3] as usize),
+        ]
+    }
+
+    /// The pairs of entry `i` when a window holds more than four: rare, so
+    /// kept out of the loop's registers.
+    #[cold]
+    #[inline(never)]
+    fn wide_pairs(&self, i: usize, f: &mut impl FnMut(u32, u32)) {
+        let e = &self.entries[i];
+        for (lo, hi) in self.windows(i, e.key as usize) {
+            scan(&e.ball, e.id, &self.entries[lo..hi], f);
         }
     }
 
@@ -387,9 +398,8 @@ impl Level {
         if self.entries.len() <= 1 {
             return;
         }
-        let last = self.per_side - 1;
-        let lo = cell_coords(p - DVec3::splat(span), self.inv_cell, last);
-        let hi = cell_coords(p + DVec3::splat(span), self.inv_cell, last);
+        let lo = cell_coords(p - DVec3::splat(span), self.inv_cell, self.top);
+        let hi = cell_coords(p + DVec3::splat(span), self.inv_cell, self.top);
         let cs = &self.cell_start;
         // As in `block_pairs`: rows hold a sphere or two, so four indices
         // are copied from each unconditionally and the real ones counted,
