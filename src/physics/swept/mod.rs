@@ -164,19 +164,26 @@ impl Swept {
     fn detect(&mut self, world: &World, dt: f64, exec: &dyn Exec) -> f64 {
         let size = world.size;
         let sp = &world.spheres;
-        // Walls come from the grid: only a sphere in a cell on a face can
-        // reach one, and most are not.
-        self.detect
-            .run(exec, sp, size, |s| path_ball(s, dt), &|_, _| true, &|_| {
-                false
+        let ball = |s: &Sphere| path_ball(s, dt);
+        if exec.functional() {
+            // `split`: the sphere–wall job (every sphere's path against the
+            // walls) runs on its own thread beside the sphere–sphere job.
+            let wall = |s: &Sphere| reaches_wall(s, size, dt);
+            self.detect.run(exec, sp, size, ball, &|_, _| true, &wall);
+            self.detect.wall_hits(&mut self.hits);
+        } else {
+            // Otherwise walls come from the grid: only a sphere in a cell
+            // on a face can reach one, and most are not. The same set.
+            self.detect
+                .run(exec, sp, size, ball, &|_, _| true, &|_| false);
+            self.hits.clear();
+            let hits = &mut self.hits;
+            self.detect.grid.near_faces(&mut |i| {
+                if reaches_wall(&sp[i as usize], size, dt) {
+                    hits.push(i);
+                }
             });
-        self.hits.clear();
-        let hits = &mut self.hits;
-        self.detect.grid.near_faces(&mut |i| {
-            if reaches_wall(&sp[i as usize], size, dt) {
-                hits.push(i);
-            }
-        });
+        }
         self.sort_pairs(sp, dt, exec)
     }
 
