@@ -351,7 +351,9 @@ impl Run {
             // Members are few: they are checked one by one with their grown
             // balls, so the grid is searched only for outsiders.
             sh.grid.near_binned(q, rq, &mut |j, pj0, rj| {
-                if this.member(j).is_none() && q.distance_squared(pj0) <= (rq + rj) * (rq + rj) {
+                // The distance first: it reads what the grid handed over,
+                // the member table is a read elsewhere in memory.
+                if q.distance_squared(pj0) <= (rq + rj) * (rq + rj) && this.member(j).is_none() {
                     found.push(j);
                 }
             });
