@@ -31,7 +31,6 @@ const BUILD_BLOCK: usize = 4096;
 const GROWTH_CAP: f64 = 2.0;
 /// The first level's cell comes from every this-many-th reach.
 const SAMPLE_STRIDE: usize = 32;
-const _: () = assert!(BUILD_BLOCK.is_multiple_of(SAMPLE_STRIDE));
 
 /// A sphere's ball for the step: it stays within `reach` of `pos`.
 #[derive(Clone, Copy, Debug, Default)]
@@ -92,10 +91,8 @@ pub struct Grid {
     /// Spheres not yet placed in a level: (ball, id).
     rest: Vec<(Ball, u32)>,
     scratch: Vec<f64>,
-    /// Per block of spheres: the widest reach, every [`SAMPLE_STRIDE`]-th
-    /// reach, and the balls too wide for the first level (found in
-    /// parallel, joined in block order).
-    block_max: Vec<Mutex<(f64, Vec<f64>)>>,
+    /// Per block of spheres, the balls too wide for the first level (found
+    /// in parallel, joined in block order).
     wide: Vec<Mutex<Vec<(Ball, u32)>>>,
     slots: Vec<Mutex<Vec<Pair>>>,
 }
@@ -125,7 +122,9 @@ fn cell_for(
     cell_of_sample(scratch, max)
 }
 
-/// [`cell_for`] of reaches already sampled into `scratch` (reordered).
+/// [`cell_for`] of reaches already sampled into `scratch` (reordered);
+/// `max` is the widest reach known (for the first level, the sample's: a
+/// sphere wider than the cell then goes up a level, as any would).
 fn cell_of_sample(scratch: &mut [f64], max: f64) -> f64 {
     if scratch.is_empty() {
         return 2.0 * max;
@@ -472,47 +471,24 @@ impl Grid {
         let n = spheres.len();
         self.size = size;
         self.top.clear();
-        self.staged.resize(n, Entry::default());
-        let blocks = n.div_ceil(BUILD_BLOCK);
-        self.block_max.resize_with(blocks, Default::default);
-        let block_max = &self.block_max;
-        for_each_chunk(exec, &mut self.staged, BUILD_BLOCK, &|b, chunk| {
-            let mut max: f64 = 0.0;
-            let first = (b * BUILD_BLOCK) as u32;
-            for ((slot, s), id) in chunk
-                .iter_mut()
-                .zip(&spheres[b * BUILD_BLOCK..])
-                .zip(first..)
-            {
-                let (pos, reach) = ball(s);
-                slot.ball = Ball { pos, reach };
-                slot.id = id;
-                if reach > max {
-                    max = reach;
-                }
-            }
-            let mut out = block_max[b].lock();
-            out.0 = max;
-            out.1.clear();
-            out.1
-                .extend(chunk.iter().step_by(SAMPLE_STRIDE).map(|s| s.ball.reach));
-        });
         let mut depth = 0;
         if n > ALL_PAIRS_MAX {
-            // First level: keys in parallel, the sort by lanes.
             if self.levels.is_empty() {
                 self.levels.push(Level::default());
             }
-            let max = self.block_max[..blocks]
-                .iter()
-                .fold(0.0f64, |m, b| m.max(b.lock().0));
+            // The first level's cell comes from a sample of the reaches (a
+            // function of the state only, so the grid, and the order pairs
+            // come out in, never depend on history); then each sphere's
+            // ball and key are made in one pass over the spheres.
             self.scratch.clear();
-            for b in &self.block_max[..blocks] {
-                self.scratch.extend_from_slice(&b.lock().1);
-            }
+            self.scratch
+                .extend(spheres.iter().step_by(SAMPLE_STRIDE).map(|s| ball(s).1));
+            let max = self.scratch.iter().fold(0.0f64, |m, &r| m.max(r));
             let want = cell_of_sample(&mut self.scratch, max);
             let level = &mut self.levels[0];
             level.shape(size, want, n, true);
+            self.staged.resize(n, Entry::default());
+            let blocks = n.div_ceil(BUILD_BLOCK);
             self.wide.resize_with(blocks, Default::default);
             {
                 let level = &*level;
@@ -520,19 +496,24 @@ impl Grid {
                 for_each_chunk(exec, &mut self.staged, BUILD_BLOCK, &|b, chunk| {
                     let mut wide = wide[b].lock();
                     wide.clear();
-                    for (k, s) in chunk.iter_mut().enumerate() {
-                        s.key = if level.fits(s.ball.reach) {
-                            level.key_of(s.ball.pos)
+                    let first = (b * BUILD_BLOCK) as u32;
+                    let mine = chunk.iter_mut().zip(&spheres[b * BUILD_BLOCK..]);
+                    for ((slot, s), id) in mine.zip(first..) {
+                        let (pos, reach) = ball(s);
+                        let ball = Ball { pos, reach };
+                        let key = if level.fits(reach) {
+                            level.key_of(pos)
                         } else {
-                            wide.push((s.ball, (b * BUILD_BLOCK + k) as u32));
+                            wide.push((ball, id));
                             u32::MAX
                         };
+                        *slot = Entry { ball, id, key };
                     }
                 });
             }
             level.fill_lanes(&self.staged, exec);
             self.rest.clear();
-            for w in &self.wide[..blocks] {
+            for w in &self.wide[..n.div_ceil(BUILD_BLOCK)] {
                 self.rest.extend_from_slice(&w.lock());
             }
             depth = 1;
@@ -573,12 +554,10 @@ impl Grid {
             }
             self.top.extend_from_slice(&self.rest);
         } else {
-            self.top.extend(
-                self.staged
-                    .iter()
-                    .enumerate()
-                    .map(|(i, s)| (s.ball, i as u32)),
-            );
+            self.top.extend(spheres.iter().zip(0..).map(|(s, i)| {
+                let (pos, reach) = ball(s);
+                (Ball { pos, reach }, i)
+            }));
         }
         self.levels.truncate(depth);
     }
