@@ -140,8 +140,8 @@ impl Swept {
             &self.hits,
         );
         // Everyone flies straight; then the spheres with events take their
-        // run's end, and the counters are summed in slot order: the same
-        // bits on any lanes.
+        // run's end, and the counters are summed in sphere order: the same
+        // bits on any lanes and however the clusters fell.
         for_each_chunk(exec, &mut world.spheres, SPHERE_BLOCK, &|_, chunk| {
             for s in chunk {
                 s.pos += s.vel * dt;

@@ -124,6 +124,10 @@ pub(super) struct Rounds {
     /// from the standing runs; by slot, the round each one's run stands from.
     cross: Vec<(u32, u32)>,
     ran: Vec<u32>,
+    /// The slots in sphere order, for [`Rounds::results`], and scratch for
+    /// the late ones.
+    in_order: Vec<u32>,
+    late: Vec<u32>,
     /// Every slot's ball for the step, and a grid to find which meet.
     balls: Vec<Sphere>,
     overlap: Grid,
@@ -137,12 +141,14 @@ pub(super) struct Rounds {
 impl Rounds {
     /// The results of the last `run`: every sphere that had events, with
     /// its run's end of the step and whether the run hit the event cap, in
-    /// a fixed order (by slot).
+    /// sphere order (so totals summed in this order are the serial loop's
+    /// to the bit, however the clusters fell).
     pub fn results(&self) -> impl Iterator<Item = (&Member, bool)> {
-        self.out
-            .iter()
-            .zip(&self.capped)
-            .map(|(m, &capped)| (m.as_ref().expect("every involved sphere finished"), capped))
+        self.in_order.iter().map(|&s| {
+            let s = s as usize;
+            let m = self.out[s].as_ref();
+            (m.expect("every involved sphere finished"), self.capped[s])
+        })
     }
 
     /// Runs the events of a step: `meets` are the pairs whose straight paths
@@ -151,6 +157,22 @@ impl Rounds {
     /// the step is then among [`Rounds::results`]; `spheres` is not changed.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
+        &mut self,
+        exec: &dyn Exec,
+        spheres: &[Sphere],
+        grid: &Grid,
+        size: f64,
+        dt: f64,
+        meets: &[(u32, u32)],
+        near: &[(u32, u32)],
+        hits: &[u32],
+    ) {
+        self.run_rounds(exec, spheres, grid, size, dt, meets, near, hits);
+        self.order_results();
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn run_rounds(
         &mut self,
         exec: &dyn Exec,
         spheres: &[Sphere],
@@ -219,6 +241,27 @@ impl Rounds {
             self.merge_conflicts();
             round += 1;
         }
+    }
+
+    /// The slots in sphere order: the first round's already are; the ones
+    /// runs took in later are merged in.
+    fn order_results(&mut self) {
+        let (m, first) = (self.ids.len(), self.first_late);
+        self.in_order.clear();
+        let ids = &self.ids;
+        let mut late = std::mem::take(&mut self.late);
+        late.clear();
+        late.extend(first as u32..m as u32);
+        late.sort_unstable_by_key(|&s| ids[s as usize]);
+        let mut early = (0..first as u32).peekable();
+        for &l in &late {
+            while let Some(e) = early.next_if(|&e| ids[e as usize] < ids[l as usize]) {
+                self.in_order.push(e);
+            }
+            self.in_order.push(l);
+        }
+        self.in_order.extend(early);
+        self.late = late;
     }
 
     /// Slots for the spheres with events and their first clusters; true
