@@ -70,7 +70,7 @@ struct Level {
     /// Padded cells per side (`per_side + 2`).
     side: usize,
     /// The last real cell's coordinate, `per_side - 1`.
-    top: f64,
+    last_cell: f64,
     inv_cell: f64,
     cell: f64,
     cell_start: Vec<u32>,
@@ -97,13 +97,13 @@ pub struct Grid {
     slots: Vec<Mutex<Vec<Pair>>>,
 }
 
-/// Real cell coordinates of `p`, clamped into `0..=top`. Truncation is
+/// Real cell coordinates of `p`, clamped into `0..=last`. Truncation is
 /// floor here (after max(0)), without a libm call; clamping in floating
-/// point first (NaN goes to 0) lets the cast be a 32-bit one. `top` comes
+/// point first (NaN goes to 0) lets the cast be a 32-bit one. `last` comes
 /// as a float: converting it here cost as much as the rest.
 #[inline]
-fn cell_coords(p: DVec3, inv_cell: f64, top: f64) -> [usize; 3] {
-    let c = |x: f64| (x * inv_cell).max(0.0).min(top) as u32 as usize;
+fn cell_coords(p: DVec3, inv_cell: f64, last: f64) -> [usize; 3] {
+    let c = |x: f64| (x * inv_cell).max(0.0).min(last) as u32 as usize;
     [c(p.x), c(p.y), c(p.z)]
 }
 
@@ -159,7 +159,7 @@ impl Level {
         self.side = self.per_side + 2;
         self.cell = size / self.per_side as f64;
         self.inv_cell = 1.0 / self.cell;
-        self.top = (self.per_side - 1) as f64;
+        self.last_cell = (self.per_side - 1) as f64;
         self.reach_max = 0.0;
         let len = self.side * self.side * self.side + 1;
         if lanes_zero {
@@ -177,7 +177,7 @@ impl Level {
 
     #[inline]
     fn key_of(&self, p: DVec3) -> u32 {
-        let [x, y, z] = cell_coords(p, self.inv_cell, self.top);
+        let [x, y, z] = cell_coords(p, self.inv_cell, self.last_cell);
         ((x + 1) + self.side * ((y + 1) + self.side * (z + 1))) as u32
     }
 
@@ -397,8 +397,8 @@ impl Level {
         if self.entries.len() <= 1 {
             return;
         }
-        let lo = cell_coords(p - DVec3::splat(span), self.inv_cell, self.top);
-        let hi = cell_coords(p + DVec3::splat(span), self.inv_cell, self.top);
+        let lo = cell_coords(p - DVec3::splat(span), self.inv_cell, self.last_cell);
+        let hi = cell_coords(p + DVec3::splat(span), self.inv_cell, self.last_cell);
         let cs = &self.cell_start;
         // As in `block_pairs`: rows hold a sphere or two, so four indices
         // are copied from each unconditionally and the real ones counted,
