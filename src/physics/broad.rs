@@ -22,6 +22,10 @@ const CROSS_BLOCK: usize = 64;
 const LANES_MIN_SPHERES: usize = 4096;
 /// Spheres per parallel block while binning.
 const BUILD_BLOCK: usize = 4096;
+/// From this many spheres per lane on, the sort into cells places indices,
+/// then copies the records (measured: 3–6 % faster at 100 000 spheres, no
+/// gain at 10 000, where everything stays in cache).
+const INDIRECT_MIN: usize = 1 << 15;
 /// How far past its level's widest ball a sphere's ball may grow in a run
 /// and still be found through the grid ([`Grid::near`] searches that much
 /// wider). Wider searches cost more each; a narrower cap sends more balls to
@@ -76,6 +80,8 @@ struct Level {
     cell_start: Vec<u32>,
     /// The spheres of this level sorted by cell key, then a `NOWHERE` pad.
     entries: Vec<Entry>,
+    /// Per lane of `fill_lanes`: where each of its entries comes from.
+    orders: Vec<Mutex<Vec<u32>>>,
     /// Largest reach in this level.
     reach_max: f64,
 }
@@ -261,6 +267,14 @@ impl Level {
         }
         offsets.push(sum);
         room(&mut self.entries, sum as usize);
+        // Past the caches, a record written anywhere in the entries costs a
+        // miss: a lane then writes only where each record goes (a small
+        // array that stays in cache) and copies the records over in order,
+        // reading them where they lie (reads of misses overlap; writes of
+        // them held the sort up).
+        let indirect = staged.len() / lanes >= INDIRECT_MIN;
+        self.orders.resize_with(lanes, Default::default);
+        let orders = &self.orders;
         let mut regions: Vec<Mutex<&mut [Entry]>> = Vec::with_capacity(lanes);
         let mut rest = &mut self.entries[..sum as usize];
         for l in 0..lanes {
@@ -280,12 +294,27 @@ impl Level {
                 *c = end;
             }
             let mut region = regions[l].lock();
-            for s in staged.iter().rev() {
+            if !indirect {
+                for s in staged.iter().rev() {
+                    if s.key >= lo && s.key < hi {
+                        let slot = &mut table[(s.key - lo) as usize];
+                        *slot -= 1;
+                        region[(*slot - offsets[l]) as usize] = *s;
+                    }
+                }
+                return;
+            }
+            let mut order = orders[l].lock();
+            order.resize(region.len(), 0);
+            for (i, s) in staged.iter().enumerate().rev() {
                 if s.key >= lo && s.key < hi {
                     let slot = &mut table[(s.key - lo) as usize];
                     *slot -= 1;
-                    region[(*slot - offsets[l]) as usize] = *s;
+                    order[(*slot - offsets[l]) as usize] = i as u32;
                 }
+            }
+            for (e, &i) in region.iter_mut().zip(order.iter()) {
+                *e = staged[i as usize];
             }
         });
         drop(tables);
