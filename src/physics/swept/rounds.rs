@@ -167,22 +167,6 @@ impl Rounds {
         near: &[(u32, u32)],
         hits: &[u32],
     ) {
-        self.run_rounds(exec, spheres, grid, size, dt, meets, near, hits);
-        self.order_results();
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn run_rounds(
-        &mut self,
-        exec: &dyn Exec,
-        spheres: &[Sphere],
-        grid: &Grid,
-        size: f64,
-        dt: f64,
-        meets: &[(u32, u32)],
-        near: &[(u32, u32)],
-        hits: &[u32],
-    ) {
         let serial = self.start(spheres.len(), meets, near, hits);
         let mut round = 0;
         loop {
@@ -241,6 +225,7 @@ impl Rounds {
             self.merge_conflicts();
             round += 1;
         }
+        self.order_results();
     }
 
     /// The slots in sphere order: the first round's already are; the ones
