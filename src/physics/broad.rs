@@ -176,6 +176,20 @@ impl Level {
         }
     }
 
+    /// Sphere `id`'s record on its way into this level: its cell's key,
+    /// or `u32::MAX` and a place in `wide` when its ball is too wide.
+    #[inline(always)]
+    fn stage(&self, (pos, reach): (DVec3, f64), id: u32, wide: &mut Vec<(Ball, u32)>) -> Entry {
+        let ball = Ball { pos, reach };
+        let key = if self.fits(reach) {
+            self.key_of(pos)
+        } else {
+            wide.push((ball, id));
+            u32::MAX
+        };
+        Entry { ball, id, key }
+    }
+
     #[inline]
     fn fits(&self, reach: f64) -> bool {
         2.0 * reach <= self.cell
@@ -216,11 +230,11 @@ impl Level {
     /// places only the keys of its range, into its own part of the cell
     /// table and of the entries, so the layout is the same for any number
     /// of lanes.
-    fn fill_lanes(&mut self, staged: &[Entry], exec: &dyn Exec) {
+    /// `counted`: the cell table already holds the counts of one lane
+    /// (made while staging), with (how many, widest reach).
+    fn fill_lanes(&mut self, staged: &[Entry], exec: &dyn Exec, counted: Option<(u32, f64)>) {
         let cells = self.cell_start.len() - 1;
-        // Under this many spheres, waking other threads costs more than the
-        // sort; the layout is the same for any number of lanes.
-        let exec: &dyn Exec = if staged.len() < LANES_MIN_SPHERES {
+        let exec: &dyn Exec = if counted.is_some() {
             &super::exec::Serial
         } else {
             exec
@@ -234,9 +248,11 @@ impl Level {
             tables.push(Mutex::new(mine));
             rest = more;
         }
-        let totals: Vec<Mutex<(u32, f64)>> = (0..lanes).map(|_| Mutex::new((0, 0.0))).collect();
+        let totals: Vec<Mutex<(u32, f64)>> = (0..lanes)
+            .map(|_| Mutex::new(counted.unwrap_or((0, 0.0))))
+            .collect();
         exec.for_each_lane(&|l| {
-            if l >= lanes {
+            if l >= lanes || counted.is_some() {
                 return;
             }
             let (lo, hi) = (bounds[l] as u32, bounds[l + 1] as u32);
@@ -517,9 +533,30 @@ impl Grid {
             let level = &mut self.levels[0];
             level.shape(size, want, n, true);
             self.staged.resize(n, Entry::default());
-            let blocks = n.div_ceil(BUILD_BLOCK);
-            self.wide.resize_with(blocks, Default::default);
-            {
+            self.rest.clear();
+            // Under this many spheres, waking other threads costs more than
+            // the sort; the layout is the same for any number of lanes.
+            if n < LANES_MIN_SPHERES || exec.lanes() <= 1 {
+                // One lane: the cells are counted while staging, so the
+                // table's increments overlap the arithmetic of the balls
+                // and the staged records are read once less.
+                level.cell_start.fill(0);
+                let (mut count, mut reach_max) = (0, 0.0f64);
+                for ((slot, s), id) in self.staged.iter_mut().zip(spheres).zip(0..) {
+                    *slot = level.stage(ball(s), id, &mut self.rest);
+                    if slot.key != u32::MAX {
+                        level.cell_start[slot.key as usize] += 1;
+                        count += 1;
+                        // Not `f64::max`: see `fill_lanes`.
+                        if slot.ball.reach > reach_max {
+                            reach_max = slot.ball.reach;
+                        }
+                    }
+                }
+                level.fill_lanes(&self.staged, exec, Some((count, reach_max)));
+            } else {
+                let blocks = n.div_ceil(BUILD_BLOCK);
+                self.wide.resize_with(blocks, Default::default);
                 let level = &*level;
                 let wide = &self.wide;
                 for_each_chunk(exec, &mut self.staged, BUILD_BLOCK, &|b, chunk| {
@@ -528,22 +565,13 @@ impl Grid {
                     let first = (b * BUILD_BLOCK) as u32;
                     let mine = chunk.iter_mut().zip(&spheres[b * BUILD_BLOCK..]);
                     for ((slot, s), id) in mine.zip(first..) {
-                        let (pos, reach) = ball(s);
-                        let ball = Ball { pos, reach };
-                        let key = if level.fits(reach) {
-                            level.key_of(pos)
-                        } else {
-                            wide.push((ball, id));
-                            u32::MAX
-                        };
-                        *slot = Entry { ball, id, key };
+                        *slot = level.stage(ball(s), id, &mut wide);
                     }
                 });
-            }
-            level.fill_lanes(&self.staged, exec);
-            self.rest.clear();
-            for w in &self.wide[..n.div_ceil(BUILD_BLOCK)] {
-                self.rest.extend_from_slice(&w.lock());
+                self.levels[0].fill_lanes(&self.staged, exec, None);
+                for w in &self.wide[..blocks] {
+                    self.rest.extend_from_slice(&w.lock());
+                }
             }
             depth = 1;
             // Coarser levels for what did not fit, serially: they are few.
