@@ -29,8 +29,22 @@ pub(super) struct Shared<'a> {
     pub grid: &'a Grid,
     /// Sphere id → its slot among the involved spheres, or NONE.
     pub slot: &'a [u32],
+    /// By slot of the first round: where its partners among the step's
+    /// pairs start in `partners` (see [`Shared::partners_of`]).
+    pub partner_start: &'a [u32],
+    pub partners: &'a [u32],
     pub size: f64,
     pub dt: f64,
+}
+
+impl Shared<'_> {
+    /// Every sphere whose binned ball meets the binned ball of the sphere
+    /// in `slot`, if that slot was indexed.
+    fn partners_of(&self, slot: u32) -> Option<&[u32]> {
+        let s = slot as usize;
+        let end = *self.partner_start.get(s.checked_add(1)?)?;
+        Some(&self.partners[self.partner_start[s] as usize..end as usize])
+    }
 }
 
 /// An event; `a`, `b` are sphere ids (`b` NONE for a wall), `la`, `lb` the
@@ -350,13 +364,27 @@ impl Run {
         if !absorb && self.ids.len() <= SMALL_RUN {
             // Members are few: they are checked one by one with their grown
             // balls, so the grid is searched only for outsiders.
-            sh.grid.near_binned(q, rq, &mut |j, pj0, rj| {
+            let mut outsider = |j: u32, pj0: DVec3, rj: f64| {
                 // The distance first: it reads what the grid handed over,
                 // the member table is a read elsewhere in memory.
                 if q.distance_squared(pj0) <= (rq + rj) * (rq + rj) && this.member(j).is_none() {
                     found.push(j);
                 }
-            });
+            };
+            // When the ball around the rest of the path lies inside the
+            // sphere's binned ball (well inside: far above rounding), every
+            // outsider it can meet is one of the pairs the grid already
+            // found for it, and the same test picks the same ones.
+            let inside = (q - this.centre[la]).length() + rq <= this.reach0[la] * (1.0 - 1e-9);
+            match sh.partners_of(this.slots[la]).filter(|_| inside) {
+                Some(partners) => {
+                    for &j in partners {
+                        let (pj0, rj) = path_ball(&sh.spheres[j as usize], sh.dt);
+                        outsider(j, pj0, rj);
+                    }
+                }
+                None => sh.grid.near_binned(q, rq, &mut outsider),
+            }
             for l in 0..this.ids.len() {
                 let r = rq + this.reach[l];
                 if l != la && q.distance_squared(this.centre[l]) <= r * r {

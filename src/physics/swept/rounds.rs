@@ -99,6 +99,10 @@ pub(super) struct Rounds {
     meets_of: Vec<u32>,
     /// By meeting pair: the slot of its first sphere.
     meet_slot: Vec<u32>,
+    /// By slot of the first round: where its partners among the step's
+    /// pairs (meeting or near) start in `partners`.
+    partner_start: Vec<u32>,
+    partners: Vec<u32>,
     /// Set by `merge_all`: the next partition is one cluster of everyone.
     whole: bool,
     /// Scratch for one cluster's members and pairs.
@@ -202,6 +206,8 @@ impl Rounds {
                 spheres,
                 grid,
                 slot: &self.slot,
+                partner_start: &self.partner_start,
+                partners: &self.partners,
                 size,
                 dt,
             };
@@ -301,7 +307,9 @@ impl Rounds {
         // up at N = 100 000, rounds cost more than one serial run).
         let serial = self.serial_only || 10 * m > 3 * n;
         if serial {
-            // One cluster: every slot's parent is slot 0.
+            // One cluster: every slot's parent is slot 0. No rescan looks
+            // up partners (the one run searches the grid).
+            self.partner_start.clear();
             self.merge_all();
             return true;
         }
@@ -314,7 +322,42 @@ impl Rounds {
                 self.union(a, b);
             }
         }
+        self.index_partners(meets, near);
         false
+    }
+
+    /// Each first-round slot's partners among the pairs the grid found
+    /// (counting sort by slot): a rescan whose ball lies inside the
+    /// sphere's binned one finds everyone it can meet among them.
+    fn index_partners(&mut self, meets: &[(u32, u32)], near: &[(u32, u32)]) {
+        let m = self.ids.len();
+        let (start, slot) = (&mut self.partner_start, &self.slot);
+        start.clear();
+        start.resize(m + 1, 0);
+        for &(i, j) in meets.iter().chain(near) {
+            for k in [i, j] {
+                let a = slot[k as usize];
+                if a != NONE {
+                    start[a as usize] += 1;
+                }
+            }
+        }
+        let mut sum = 0;
+        for c in start.iter_mut() {
+            sum += *c;
+            *c = sum;
+        }
+        self.partners.resize(sum as usize, 0);
+        for &(i, j) in meets.iter().chain(near).rev() {
+            for (k, other) in [(j, i), (i, j)] {
+                let a = slot[k as usize];
+                if a != NONE {
+                    let end = &mut start[a as usize];
+                    *end -= 1;
+                    self.partners[*end as usize] = other;
+                }
+            }
+        }
     }
 
     fn find(&mut self, mut x: u32) -> u32 {
