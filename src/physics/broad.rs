@@ -113,6 +113,34 @@ fn cell_coords(p: DVec3, inv_cell: f64, last: f64) -> [usize; 3] {
     [c(p.x), c(p.y), c(p.z)]
 }
 
+/// Inclusive running sums of `counts`, from `start` on; returns the last.
+/// The table has several cells per sphere, so this pass is long: each
+/// block of eight is summed on its own and only the blocks' totals form a
+/// chain, one add per eight cells instead of one per cell.
+fn running_sums(counts: &mut [u32], start: u32) -> u32 {
+    let mut end = start;
+    let mut blocks = counts.chunks_exact_mut(8);
+    for block in &mut blocks {
+        let mut v: [u32; 8] = block.try_into().expect("eight");
+        // Sums within the block by doubling shifts: vector adds, no chain.
+        for shift in [1, 2, 4] {
+            let prev = v;
+            for k in shift..8 {
+                v[k] += prev[k - shift];
+            }
+        }
+        for (c, l) in block.iter_mut().zip(v) {
+            *c = end + l;
+        }
+        end += v[7];
+    }
+    for c in blocks.into_remainder() {
+        end += *c;
+        *c = end;
+    }
+    end
+}
+
 /// Twice the 98th percentile of `reach` (estimated on every `stride`-th
 /// value: a function of the state only, so the grid, and the order pairs
 /// come out in, never depend on history), or twice `max` when the fastest is
@@ -211,11 +239,7 @@ impl Level {
             self.cell_start[e.key as usize] += 1;
         }
         let cells = self.cell_start.len() - 1;
-        let mut sum = 0;
-        for c in &mut self.cell_start[..cells] {
-            sum += *c;
-            *c = sum;
-        }
+        let sum = running_sums(&mut self.cell_start[..cells], 0);
         self.cell_start[cells] = sum;
         room(&mut self.entries, sum as usize);
         for e in items.iter().rev() {
@@ -304,11 +328,7 @@ impl Level {
             }
             let (lo, hi) = (bounds[l] as u32, bounds[l + 1] as u32);
             let mut table = tables[l].lock();
-            let mut end = offsets[l];
-            for c in table.iter_mut() {
-                end += *c;
-                *c = end;
-            }
+            running_sums(&mut table, offsets[l]);
             let mut region = regions[l].lock();
             if !indirect {
                 for s in staged.iter().rev() {
