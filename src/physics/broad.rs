@@ -186,9 +186,11 @@ impl Level {
     /// table is zeroed here unless `lanes_zero` (the lanes of `fill_lanes`
     /// zero their own parts: at 100 000 spheres the table is megabytes).
     fn shape(&mut self, size: f64, want: f64, n: usize, lanes_zero: bool) {
-        // At most ~8 cells per sphere (empty cells cost nothing to skip)
-        // and 1024 per side keep memory O(N).
-        let cap = ((8 * n.max(1)) as f64).cbrt().ceil().clamp(1.0, 1024.0);
+        // At most ~4 cells per sphere and 1024 per side keep memory O(N).
+        // Empty cells are cheap to skip in the search, but every step counts,
+        // sums and reads the whole table: with 8 per sphere, 100 000 dilute
+        // spheres ran 3 % slower (the table left the cache), 10 000 1 %.
+        let cap = ((4 * n.max(1)) as f64).cbrt().ceil().clamp(1.0, 1024.0);
         self.per_side = (size / want.max(f64::MIN_POSITIVE)).floor().clamp(1.0, cap) as usize;
         self.side = self.per_side + 2;
         self.cell = size / self.per_side as f64;
