@@ -216,7 +216,15 @@ impl Run {
                 s.pos += s.vel * sh.dt;
                 continue;
             }
-            let (imp, hits) = fly(&mut self.sp[l], sh.size, sh.dt - self.t_local[l]);
+            let rest = sh.dt - self.t_local[l];
+            if !self.capped {
+                // Every wall it reaches before the step ends was an event:
+                // the rest of its path is straight.
+                let s = &mut self.sp[l];
+                s.pos += s.vel * rest;
+                continue;
+            }
+            let (imp, hits) = fly(&mut self.sp[l], sh.size, rest);
             self.wall_momentum[l] += imp;
             self.wall_hits[l] += hits as u32;
         }
