@@ -330,34 +330,21 @@ impl Rounds {
     /// (counting sort by slot): a rescan whose ball lies inside the
     /// sphere's binned one finds everyone it can meet among them.
     fn index_partners(&mut self, meets: &[(u32, u32)], near: &[(u32, u32)]) {
-        let m = self.ids.len();
-        let (start, slot) = (&mut self.partner_start, &self.slot);
-        start.clear();
-        start.resize(m + 1, 0);
-        for &(i, j) in meets.iter().chain(near) {
-            for k in [i, j] {
-                let a = slot[k as usize];
-                if a != NONE {
-                    start[a as usize] += 1;
-                }
-            }
-        }
-        let mut sum = 0;
-        for c in start.iter_mut() {
-            sum += *c;
-            *c = sum;
-        }
-        self.partners.resize(sum as usize, 0);
-        for &(i, j) in meets.iter().chain(near).rev() {
-            for (k, other) in [(j, i), (i, j)] {
-                let a = slot[k as usize];
-                if a != NONE {
-                    let end = &mut start[a as usize];
-                    *end -= 1;
-                    self.partners[*end as usize] = other;
-                }
-            }
-        }
+        let slot = &self.slot;
+        let ends = meets
+            .iter()
+            .chain(near)
+            .flat_map(|&(i, j)| [(i, j), (j, i)]);
+        let by_slot = ends.filter_map(|(k, other)| {
+            let a = slot[k as usize];
+            (a != NONE).then_some((a, other))
+        });
+        group(
+            &mut self.partner_start,
+            &mut self.partners,
+            self.ids.len(),
+            by_slot,
+        );
     }
 
     fn find(&mut self, mut x: u32) -> u32 {
