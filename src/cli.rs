@@ -12,7 +12,9 @@ use std::path::PathBuf;
     name = "ballpit",
     version,
     about = "Elastic spheres in a cube, on worker threads, drawn in your terminal",
-    after_help = "Without a subcommand, opens the terminal app. Press ? in it for the keys."
+    after_help = "Without a subcommand, opens the terminal app. Press ? in it for the keys.",
+    // `--dt -1` must reach the validators and their message, not read as a flag.
+    allow_negative_numbers = true
 )]
 pub struct Cli {
     #[command(subcommand)]
@@ -32,8 +34,10 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Run a scene headless and print one JSON line
+    #[command(allow_negative_numbers = true)]
     Bench(BenchArgs),
     /// Measure speed against accuracy for every model over a ladder of dt
+    #[command(allow_negative_numbers = true)]
     Tradeoff(TradeoffArgs),
 }
 

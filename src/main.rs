@@ -32,15 +32,26 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 .tick
                 .unwrap_or_else(|| args.steps.div_ceil(100).clamp(1, u64::from(u32::MAX)) as u32);
             let world = scene::build_world(&args.scene.spec())?;
+            let dump = args
+                .dump
+                .as_deref()
+                .map(scene::csv_io::create)
+                .transpose()?;
             let (report, world) = bench::run(world, &settings, args.steps)?;
-            if let Some(path) = &args.dump {
-                scene::csv_io::dump(&world, path)?;
+            if let Some(file) = dump {
+                file.write(&world)?;
             }
             println!("{}", serde_json::to_string(&report)?);
             Ok(())
         }
         Some(Command::Tradeoff(args)) => {
             let world = scene::build_world(&args.scene.spec())?;
+            if let Some(dir) = &args.out {
+                // Before the minutes of measuring, not after.
+                std::fs::create_dir_all(dir).map_err(|e| {
+                    BadInput(format!("cannot create directory {}: {e}", dir.display()))
+                })?;
+            }
             ballpit::tradeoff::run(world, args.out.as_deref())
         }
         None => {

@@ -79,11 +79,28 @@ pub fn write(world: &World, out: &mut impl Write) -> std::io::Result<()> {
     Ok(())
 }
 
-pub fn dump(world: &World, path: &Path) -> Result<(), BadInput> {
+/// Opens `path` for a dump, before the run that makes the world: a path
+/// that cannot be written fails at once, not after a long run.
+pub fn create(path: &Path) -> Result<DumpFile, BadInput> {
     let file = std::fs::File::create(path)
         .map_err(|e| bad_input!("cannot write {}: {e}", path.display()))?;
-    let mut w = std::io::BufWriter::new(file);
-    write(world, &mut w)
-        .and_then(|_| w.flush())
-        .map_err(|e| bad_input!("cannot write {}: {e}", path.display()))
+    Ok(DumpFile {
+        file,
+        path: path.to_owned(),
+    })
+}
+
+/// A sphere CSV opened by [`create`], written by [`DumpFile::write`].
+pub struct DumpFile {
+    file: std::fs::File,
+    path: std::path::PathBuf,
+}
+
+impl DumpFile {
+    pub fn write(self, world: &World) -> Result<(), BadInput> {
+        let mut w = std::io::BufWriter::new(self.file);
+        write(world, &mut w)
+            .and_then(|_| w.flush())
+            .map_err(|e| bad_input!("cannot write {}: {e}", self.path.display()))
+    }
 }
