@@ -52,6 +52,23 @@ fn bench_prints_one_json_line_with_every_field() {
 }
 
 #[test]
+fn an_empty_box_reads_zero_not_minus_zero() {
+    let v = json(&["--steps", "3", "--count", "0"]);
+    assert_eq!(v["n"], 0);
+    for field in [
+        "energy_start",
+        "energy_end",
+        "energy_drift_rel",
+        "temperature",
+    ] {
+        let x = v[field].as_f64().unwrap();
+        assert!(x == 0.0 && x.is_sign_positive(), "{field}: {x}");
+    }
+    assert_eq!(v["sphere_collisions"], 0);
+    assert_eq!(v["wall_collisions"], 0);
+}
+
+#[test]
 fn dump_reads_back_as_the_same_scene() {
     let dir = std::env::temp_dir().join(format!("ballpit-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -89,6 +106,12 @@ fn bad_input_exits_2_with_one_clear_message() {
         "x,y,z,vx,vy,vz,radius,mass\n0.5,0.5,0.5,0,0,0,0.1,1\n0.55,0.5,0.5,0,0,0,0.1,1\n",
     )
     .unwrap();
+    let fast = dir.join("fast.csv");
+    std::fs::write(
+        &fast,
+        "x,y,z,vx,vy,vz,radius,mass\n0.5,0.5,0.5,1e200,0,0,0.1,1\n",
+    )
+    .unwrap();
     let broken = dir.join("broken.toml");
     std::fs::write(&broken, "count = [\n").unwrap();
     let cases: Vec<(Vec<String>, &str)> = vec![
@@ -100,6 +123,20 @@ fn bad_input_exits_2_with_one_clear_message() {
         (vec!["--speed".into(), "inf".into()], "--speed must be"),
         (vec!["--box=-1".into()], "--box must be"),
         (vec!["--dt".into(), "0".into()], "--dt must be"),
+        // A negative number after a flag is a value, judged by the validators.
+        (
+            vec!["--dt".into(), "-1".into()],
+            "--dt must be a finite number > 0, got -1",
+        ),
+        (vec!["--radius".into(), "-0.1".into()], "--radius must be"),
+        (
+            vec!["--speed".into(), "1e200".into()],
+            "--speed 1e200 is too large",
+        ),
+        (
+            vec!["--scene".into(), fast.to_str().unwrap().into()],
+            "line 2: velocity [1e200, 0.0, 0.0] is too fast",
+        ),
         (vec!["--tick=-1".into()], "--tick"),
         (vec!["--threads".into(), "0".into()], "--threads must be"),
         (
@@ -152,6 +189,38 @@ fn bad_input_exits_2_with_one_clear_message() {
     }
     let out = ballpit().arg("bench").output().unwrap();
     assert_eq!(out.status.code(), Some(2), "missing --steps");
+    // Output paths are checked before the run: these runs would not end
+    // for hours (the timeout only stops a regression from hanging the suite).
+    let nowhere = dir.join("missing").join("out");
+    let nowhere = nowhere.to_str().unwrap();
+    for (args, want) in [
+        (
+            vec![
+                "bench",
+                "--count",
+                "2",
+                "--steps",
+                "1000000000000",
+                "--dump",
+                nowhere,
+            ],
+            "cannot write",
+        ),
+        (
+            vec!["tradeoff", "--count", "2", "--out", "/proc/ballpit-out"],
+            "cannot create directory /proc/ballpit-out",
+        ),
+    ] {
+        let out = ballpit()
+            .args(&args)
+            .timeout(std::time::Duration::from_secs(120))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(want), "{args:?}: got `{err}`, want `{want}`");
+        assert!(out.stdout.is_empty(), "{args:?}");
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

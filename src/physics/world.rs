@@ -35,7 +35,8 @@ impl World {
 
     pub fn kinetic_energy(&self) -> f64 {
         // Fixed order: energy figures are part of what must be reproducible.
-        self.spheres.iter().map(Sphere::kinetic_energy).sum()
+        // From +0, not `sum`'s -0, so an empty box reads 0.
+        self.spheres.iter().fold(0.0, |e, s| e + s.kinetic_energy())
     }
 
     pub fn momentum(&self) -> glam::DVec3 {

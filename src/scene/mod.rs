@@ -107,6 +107,11 @@ pub fn build_world(spec: &SceneSpec) -> Result<World, BadInput> {
     }
     let mut rng = place::rng(spec.seed.unwrap_or(DEFAULT_SEED));
     let world = place::generate(preset, count, radius, speed, size, &mut rng)?;
+    if !(world.spheres.iter().all(place::speed_ok) && world.kinetic_energy().is_finite()) {
+        return bad!(
+            "--speed {speed:e} is too large: the spheres' energies or relative speeds squared would not be finite numbers"
+        );
+    }
     place::check(&world, &|i| format!("generated sphere {i}"))?;
     Ok(world)
 }

@@ -219,6 +219,13 @@ pub fn check(world: &World, what: &dyn Fn(usize) -> String) -> Result<(), BadInp
         if !(s.pos.is_finite() && s.vel.is_finite() && s.radius.is_finite() && s.mass.is_finite()) {
             return bad!("{}: a value is not a finite number", what(i));
         }
+        if !speed_ok(s) {
+            return bad!(
+                "{}: velocity {:?} is too fast (its kinetic energy, or a relative speed squared, is not a finite number)",
+                what(i),
+                s.vel.to_array()
+            );
+        }
         if s.radius <= 0.0 {
             return bad!("{}: radius must be positive, got {}", what(i), s.radius);
         }
@@ -255,5 +262,17 @@ pub fn check(world: &World, what: &dyn Fn(usize) -> String) -> Result<(), BadInp
     if let Some((i, j, depth)) = first {
         return bad!("{} and {} overlap by {depth}", what(i), what(j));
     }
+    if !world.kinetic_energy().is_finite() {
+        return bad!(
+            "the spheres' total kinetic energy is not a finite number: speeds or masses too large"
+        );
+    }
     Ok(())
+}
+
+/// Whether a sphere's speed leaves the physics finite numbers: times of
+/// impact square relative speeds (up to twice its own), and the energy
+/// figures square its own.
+pub fn speed_ok(s: &Sphere) -> bool {
+    (2.0 * s.vel).length_squared().is_finite() && s.kinetic_energy().is_finite()
 }
