@@ -2,9 +2,13 @@
 //! sphere-steps per second: a small target for profilers (callgrind counts
 //! the instructions of a step as the difference of two step counts).
 //!
-//! `cargo run --release --example step -- swept 10000 0.005 200 [speed] [threads|sK] [box]`
+//! `cargo run --release --example step -- swept 10000 0.005 200 [speed] [threads|sK] [box] [parts]`
+//!
+//! `parts` (swept only): cut every step into that many parts instead of
+//! the number the scene calls for (0: that number).
 use ballpit::physics::sphere::volume;
-use ballpit::physics::{Exec, ModelKind, Serial};
+use ballpit::physics::swept::Swept;
+use ballpit::physics::{Exec, Model, ModelKind, Serial};
 use ballpit::scene::{SceneSpec, build_world};
 use std::time::Instant;
 
@@ -45,7 +49,11 @@ fn main() {
         None if sequential => &one_by_one,
         None => &Serial,
     };
-    let mut m = model.build();
+    let parts: u32 = arg(7, "0").parse().expect("parts");
+    let mut m: Box<dyn Model> = match (model, parts) {
+        (ModelKind::Swept, k @ 1..) => Box::new(Swept::default().fixed_parts(Some(k))),
+        _ => model.build(),
+    };
     let start = Instant::now();
     exec.host(&mut || m.advance(&mut world, 1.0 / 60.0, steps, exec));
     let secs = start.elapsed().as_secs_f64();

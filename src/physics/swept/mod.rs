@@ -12,7 +12,12 @@
 //! lanes (`rounds.rs`, `cluster.rs`); the result is the serial loop's to the
 //! bit. The engine's overlap readout comes from the next step's detection,
 //! which that step then reuses.
+//!
+//! When paths are long against the gaps between spheres (fast or crowded
+//! scenes), a step is cut into equal parts, each run as above, so the
+//! pairs and clusters stay those of short paths (`parts.rs`).
 mod cluster;
+mod parts;
 mod rounds;
 
 use super::broad::Pair;
@@ -47,6 +52,12 @@ pub struct Swept {
     /// Per block of candidate pairs: the deepest overlap among them.
     overlap: Vec<Mutex<f64>>,
     rounds: Rounds,
+    /// Parts per step when not the scene's choice.
+    fixed_parts: Option<u32>,
+    /// The last step's `rounds` stats, over all its parts.
+    step_stats: RoundStats,
+    /// Parts the last step was cut into.
+    last_parts: u32,
     /// Detection already made for the next step of the world it names.
     ahead: Option<Ahead>,
 }
@@ -80,7 +91,16 @@ impl Model for Swept {
 
     fn advance(&mut self, world: &mut World, dt: f64, steps: u64, exec: &dyn Exec) {
         for _ in 0..steps {
-            self.step(world, dt, exec);
+            let k = self.parts_of(world, dt);
+            self.last_parts = k;
+            let part = dt / f64::from(k);
+            let mut capped = false;
+            self.step_stats = RoundStats::default();
+            for _ in 0..k {
+                capped |= self.step(world, part, exec);
+                self.step_stats.add(&self.rounds.stats);
+            }
+            world.counters.capped_steps += u64::from(capped);
             world.time += dt;
         }
     }
@@ -94,6 +114,8 @@ impl Model for Swept {
     /// So the overlap costs nothing extra, and the next step reuses the
     /// detection if the world is still the same.
     fn max_overlap_rel(&mut self, world: &World, dt: f64, exec: &dyn Exec) -> Option<f64> {
+        // The detection of the next step's first part.
+        let dt = dt / f64::from(self.parts_of(world, dt));
         let print = fingerprint(world);
         if let Some(a) = self.ahead
             && a.dt == dt
@@ -110,7 +132,25 @@ impl Model for Swept {
 impl Swept {
     /// How the last step's events were cut into clusters.
     pub fn round_stats(&self) -> RoundStats {
-        self.rounds.stats
+        self.step_stats
+    }
+
+    /// How many parts the last step was cut into (see `parts.rs`).
+    pub fn last_parts(&self) -> u32 {
+        self.last_parts
+    }
+
+    /// Cut every step into `k` parts instead of the number the scene
+    /// calls for (see `parts.rs`); `None` goes back to that.
+    pub fn fixed_parts(mut self, k: Option<u32>) -> Self {
+        self.fixed_parts = k.map(|k| k.clamp(1, parts::MAX_PARTS));
+        self
+    }
+
+    /// The parts a step of `dt` from `world` is cut into.
+    fn parts_of(&self, world: &World, dt: f64) -> u32 {
+        self.fixed_parts
+            .unwrap_or_else(|| parts::parts(&world.spheres, world.size, dt))
     }
 
     /// Run every step's events as one serial loop, not in clusters (the
@@ -120,7 +160,9 @@ impl Swept {
         self
     }
 
-    fn step(&mut self, world: &mut World, dt: f64, exec: &dyn Exec) {
+    /// One part of a step (see `parts.rs`); returns whether it hit the
+    /// event cap.
+    fn step(&mut self, world: &mut World, dt: f64, exec: &dyn Exec) -> bool {
         let size = world.size;
         let ready = self
             .ahead
@@ -156,7 +198,7 @@ impl Swept {
             c.wall_collisions += u64::from(m.wall_hits);
             capped |= cap;
         }
-        c.capped_steps += u64::from(capped);
+        capped
     }
 
     /// Finds the pairs and walls of a step of `dt` from `world`; returns the

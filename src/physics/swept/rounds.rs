@@ -53,7 +53,8 @@ struct BlockOut {
     cross: Vec<(u32, u32)>,
 }
 
-/// How a step's events were cut, for benches and tests.
+/// How a step's events were cut, for benches and tests (for a step cut
+/// into parts, summed over them; `rounds` the most any part took).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RoundStats {
     /// Clusters of the first round.
@@ -67,6 +68,18 @@ pub struct RoundStats {
     /// of those were found apart (no rerun needed).
     pub compared: usize,
     pub apart: usize,
+}
+
+impl RoundStats {
+    /// Takes in the stats of another part of the same step.
+    pub fn add(&mut self, o: &RoundStats) {
+        self.clusters += o.clusters;
+        self.rounds = self.rounds.max(o.rounds);
+        self.reruns += o.reruns;
+        self.involved += o.involved;
+        self.compared += o.compared;
+        self.apart += o.apart;
+    }
 }
 
 /// A cluster to run: members `order[m0..m1]`, meeting pairs
