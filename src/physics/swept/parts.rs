@@ -16,17 +16,23 @@
 use crate::physics::sphere::Sphere;
 use std::f64::consts::PI;
 
-/// At most this many spheres are sampled.
-const SAMPLE: usize = 64;
+/// One sphere in this many is sampled, at least [`SAMPLE_MIN`] and at most
+/// [`SAMPLE_MAX`] of them: the estimate's noise is a few per cent from
+/// 10 000 spheres up, for a cost under 0.5 % of a step.
+const SAMPLE_EVERY: usize = 32;
+const SAMPLE_MIN: usize = 64;
+const SAMPLE_MAX: usize = 1024;
 /// No more parts than this.
 pub const MAX_PARTS: u32 = 256;
 /// Pairs per sphere the motion may add in one part. Measured
-/// (`examples/step`, `ballpit bench`), the best k of each scene left
-/// between 0.18 and 0.34: gas at packing 0.1 (10k: k = 2, 15 % faster;
-/// 100k: k = 3–4, 3× faster), dense 100k (k = 8, 3×), projectiles (200:
-/// k = 4–8, 2.2×; 1 000: k = 8, 5.6×; 3 000: k = 16, 21×); at packing
-/// 0.005 any cut was slower.
-const ADDED_PAIRS: f64 = 0.3;
+/// (`examples/step` with its `parts` argument, `ballpit bench`), the best k
+/// of each scene added: gas at packing 0.1, 0.24 (10k, k = 2, 15 % faster)
+/// and 0.31 (100k, k = 4, 3×); dense (0.4) 2k, 0.32 (k = 6, 1.6×) and 100k,
+/// under 0.4 (k = 24–32, 5×); projectiles 200, 0.34 (k = 4, 2.2×), 1 000,
+/// 0.29 (k = 8, 5.6×). At the edge: 100 000 at packing 0.005 adds 0.36
+/// whole, and two parts are 8–15 % faster; 10 000 at 0.042 adds 0.32
+/// whole, and two parts are 8 % slower.
+const ADDED_PAIRS: f64 = 0.34;
 
 /// Moments of a sphere's path-ball reach `r + s τ` (`s` its speed), as
 /// sums over the sample of `r^a s^b`, for every τ at once.
@@ -46,7 +52,9 @@ struct Moments {
 
 impl Moments {
     fn of(spheres: &[Sphere]) -> Self {
-        let stride = spheres.len().div_ceil(SAMPLE).max(1);
+        let n = spheres.len();
+        let samples = (n / SAMPLE_EVERY).clamp(SAMPLE_MIN, SAMPLE_MAX);
+        let stride = n.div_ceil(samples).max(1);
         let mut m = Moments::default();
         for sp in spheres.iter().step_by(stride) {
             let (r, s) = (sp.radius, sp.vel.length());
