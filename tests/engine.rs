@@ -489,3 +489,30 @@ fn radius_grows_until_spheres_touch() {
     let s = &w.spheres[0];
     assert!((s.mass / ballpit::physics::sphere::volume(s.radius) - 1.0).abs() < 1e-12);
 }
+
+/// The snapshot tells the screen how many parts `swept` cut its last step
+/// into: several for fast spheres in a crowd, on every threading mode.
+#[test]
+fn snapshots_carry_the_parts_of_the_last_step() {
+    // 3 000 spheres of radius 0.005 at 20 box lengths a second: paths long
+    // against the gaps.
+    let fast = scene(3000, 0.005, 0.0, 0, 20.0, 5);
+    for (threading, threads) in [(Threading::Off, 1), (Threading::Pool, 2)] {
+        let mut e = Engine::new(
+            fast.clone(),
+            settings(ModelKind::Swept, threading, threads, 1),
+        )
+        .unwrap();
+        e.start_frame().unwrap();
+        let parts = e.finish_frame().unwrap().parts;
+        assert!(parts > 4, "{threading:?}: {parts}");
+    }
+    let mut e = Engine::new(fast, settings(ModelKind::Exact, Threading::Off, 1, 1)).unwrap();
+    e.start_frame().unwrap();
+    assert_eq!(e.finish_frame().unwrap().parts, 1);
+    // A slow gas stays whole.
+    let slow = scene(1000, 0.01, 0.0, 0, 0.5, 5);
+    let mut e = Engine::new(slow, settings(ModelKind::Swept, Threading::Off, 1, 1)).unwrap();
+    e.start_frame().unwrap();
+    assert_eq!(e.finish_frame().unwrap().parts, 1);
+}

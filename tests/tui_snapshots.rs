@@ -102,6 +102,20 @@ fn readouts_panel() {
 }
 
 #[test]
+fn readouts_panel_says_when_steps_are_cut_into_parts() {
+    let mut snap = snapshot();
+    let whole = format!(
+        "{:?}",
+        readouts(&state(), &snap, Palette::C16).backend().buffer()
+    );
+    assert!(!whole.contains("steps cut"), "{whole}");
+    snap.parts = 4;
+    let t = readouts(&state(), &snap, Palette::C16);
+    let text = format!("{:?}", t.backend().buffer());
+    assert!(text.contains("swept    steps cut in 4"), "{text}");
+}
+
+#[test]
 fn readouts_panel_says_when_the_event_cap_was_hit() {
     let mut snap = snapshot();
     snap.counters.capped_steps = 3;

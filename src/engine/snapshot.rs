@@ -31,6 +31,8 @@ pub struct Snapshot {
     pub max_overlap_rel: f64,
     pub escaped: usize,
     pub counters: Counters,
+    /// Parts the model cut its last step into (1: whole).
+    pub parts: u32,
     /// Wall-clock seconds the physics of this frame took.
     pub physics_seconds: f64,
     /// Steps run in this frame.
@@ -54,6 +56,7 @@ impl Snapshot {
             max_overlap_rel: 0.0,
             escaped: 0,
             counters: Counters::default(),
+            parts: 1,
             physics_seconds: 0.0,
             steps: 0,
             settings,
@@ -98,6 +101,7 @@ impl Snapshot {
             escaped.fetch_add(out, Ordering::Relaxed);
         });
         self.energy = world.kinetic_energy();
+        self.parts = model.as_ref().map_or(1, |(m, _)| m.last_parts());
         // A model may know the overlap from its next step's detection.
         self.max_overlap_rel = model
             .and_then(|(m, dt)| m.max_overlap_rel(world, dt, exec))

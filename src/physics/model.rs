@@ -69,6 +69,10 @@ pub trait Model: Send {
     fn advance(&mut self, world: &mut World, dt: f64, steps: u64, exec: &dyn Exec);
     /// The spheres were changed from outside (added, removed, resized).
     fn invalidate(&mut self) {}
+    /// Into how many parts the model cut its last step (1: whole).
+    fn last_parts(&self) -> u32 {
+        1
+    }
     /// The deepest overlap in `world` (as `World::max_overlap_rel`), if the
     /// model can tell it from work it does anyway for a next step of `dt`;
     /// `None` leaves it to the caller.

@@ -81,7 +81,7 @@ impl Readouts<'_> {
             row("tick", tick),
             row("count", format!("{}", snap.spheres.len())),
             row("radius", format!("{:.5}", s.radius)),
-            row("model", s.model.name().to_string()),
+            row("model", model_row(s.model, snap.parts)),
             row("style", s.style.name().to_string()),
             row("colour", colour),
             row("fps", format!("{:<8.1} target {}", st.fps, s.fps)),
@@ -128,6 +128,16 @@ impl Readouts<'_> {
             lines.push(Line::from(""));
         }
         lines
+    }
+}
+
+/// The model, and the parts it cut its last step into when it did (fast
+/// or crowded scenes: see `physics/swept/parts.rs`).
+fn model_row(model: ModelKind, parts: u32) -> String {
+    if parts > 1 {
+        format!("{:<8} steps cut in {parts}", model.name())
+    } else {
+        model.name().to_string()
     }
 }
 

@@ -109,6 +109,11 @@ impl Model for Swept {
         self.ahead = None;
     }
 
+    /// See `parts.rs`.
+    fn last_parts(&self) -> u32 {
+        self.last_parts
+    }
+
     /// The next step's detection finds every pair whose balls meet, and a
     /// sphere's ball holds the sphere: the overlapping pairs are among them.
     /// So the overlap costs nothing extra, and the next step reuses the
@@ -133,11 +138,6 @@ impl Swept {
     /// How the last step's events were cut into clusters.
     pub fn round_stats(&self) -> RoundStats {
         self.step_stats
-    }
-
-    /// How many parts the last step was cut into (see `parts.rs`).
-    pub fn last_parts(&self) -> u32 {
-        self.last_parts
     }
 
     /// Cut every step into `k` parts instead of the number the scene
