@@ -100,7 +100,7 @@ pub fn parts(spheres: &[Sphere], size: f64, dt: f64) -> u32 {
     // Neighbours crowd at contact as the packing grows: the shell the
     // motion adds holds the Carnahan–Starling contact value `g` times the
     // mean density (1.3 at packing 0.1, 3.7 at 0.4).
-    let phi = (others / (size * size * size) * 4.0 / 3.0 * PI * m.rrr / m.n).min(0.64);
+    let phi = (per_volume * m.rrr / m.n).min(0.64);
     let g = (1.0 - 0.5 * phi) / (1.0 - phi).powi(3);
     // Pairs per sphere whose balls meet in a part of `k`, counted at both
     // ends, less those of the spheres themselves.
