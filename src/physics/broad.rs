@@ -29,10 +29,13 @@ const INDIRECT_MIN: usize = 1 << 15;
 /// How far past its level's widest ball a sphere's ball may grow in a run
 /// and still be found through the grid ([`Grid::near`] searches that much
 /// wider). Wider searches cost more each; a narrower cap sends more balls to
-/// the run's own list of grown ones, which every search walks: 1.5 made
-/// dense scenes of 4 000 spheres 15 % faster, but a cluster of 100 000 at
-/// packing 0.1 four times slower.
-const GROWTH_CAP: f64 = 2.0;
+/// the run's own list of grown ones, which every search walks. With whole
+/// steps 1.5 made a cluster of 100 000 at packing 0.1 four times slower than
+/// 2; since such steps are cut into parts (`swept/parts.rs`) clusters stay
+/// small, and 1.25 against 2 (`examples/parts`, `examples/step`, in turn)
+/// made dense 30k–100k 13–20 % faster and left gas at 0.005–0.1, 1k–100k,
+/// projectiles and `mixed` within ±3 %.
+const GROWTH_CAP: f64 = 1.25;
 /// The first level's cell comes from every this-many-th reach.
 const SAMPLE_STRIDE: usize = 32;
 
