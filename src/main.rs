@@ -46,12 +46,6 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Some(Command::Tradeoff(args)) => {
             let world = scene::build_world(&args.scene.spec())?;
-            if let Some(dir) = &args.out {
-                // Before the minutes of measuring, not after.
-                std::fs::create_dir_all(dir).map_err(|e| {
-                    BadInput(format!("cannot create directory {}: {e}", dir.display()))
-                })?;
-            }
             ballpit::tradeoff::run(world, args.out.as_deref())
         }
         None => {

@@ -255,10 +255,15 @@ pub fn svg(rows: &[Row], path: &Path) -> anyhow::Result<()> {
 /// Measure, print the table, and with `out` write `tradeoff.csv` and
 /// `tradeoff.svg` there.
 pub fn run(world: World, out: Option<&Path>) -> anyhow::Result<()> {
+    if let Some(dir) = out {
+        // Before the minutes of measuring, not after: a bad path is bad input.
+        std::fs::create_dir_all(dir).map_err(|e| {
+            crate::error::BadInput(format!("cannot create directory {}: {e}", dir.display()))
+        })?;
+    }
     let rows = measure(&world);
     print!("{}", markdown(&rows));
     if let Some(dir) = out {
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
         let csv_path = dir.join("tradeoff.csv");
         std::fs::write(&csv_path, csv(&rows))
             .with_context(|| format!("cannot write {}", csv_path.display()))?;
