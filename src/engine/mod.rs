@@ -108,9 +108,9 @@ pub enum Command {
     /// New spheres (median radius, rms speed, random directions) go into
     /// free space; removal drops the last ones.
     SetCount(usize),
-    /// Scale every radius so the largest becomes this (mass follows, same
-    /// density). Growth stops where spheres would touch; the snapshot's
-    /// notice says so.
+    /// Scale every radius so the largest becomes this; growing pushes the
+    /// spheres apart (masses, velocities and energy unchanged). When the box
+    /// is full, the snapshot's notice says so.
     SetRadius(f64),
     /// Back to the scene as it started.
     Reset,
