@@ -172,3 +172,114 @@ fn tempdir() -> std::path::PathBuf {
     std::fs::create_dir_all(&d).unwrap();
     d
 }
+
+mod fuzz {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn one_of(xs: &'static [&'static str]) -> impl Strategy<Value = &'static str> {
+        proptest::sample::select(xs)
+    }
+
+    /// Scene flags from the edges that broke before, valid and not.
+    fn flags() -> impl Strategy<Value = Vec<String>> {
+        (
+            one_of(&[
+                "gas",
+                "billiards",
+                "dense",
+                "projectiles",
+                "cradle",
+                "mixed",
+                "nope",
+            ]),
+            proptest::option::of(one_of(&["0", "1", "2", "10", "3000", "-1", "1e3", "x"])),
+            proptest::option::of(one_of(&[
+                "0.02", "0.0001", "1e-9", "1e-13", "1e-300", "0.49", "0.5", "2", "0", "-0.1",
+                "NaN", "inf",
+            ])),
+            proptest::option::of(one_of(&[
+                "0.5", "0", "1e-300", "1e3", "1e200", "1e308", "-1", "NaN",
+            ])),
+            proptest::option::of(one_of(&[
+                "1", "1e-80", "1e-30", "1e30", "1e100", "0", "-2", "inf",
+            ])),
+        )
+            .prop_map(|(scene, count, radius, speed, size)| {
+                let mut a = vec!["--scene".to_string(), scene.to_string()];
+                for (flag, v) in [
+                    ("--count", count),
+                    ("--radius", radius),
+                    ("--speed", speed),
+                    ("--box", size),
+                ] {
+                    if let Some(v) = v {
+                        a.push(flag.into());
+                        a.push(v.into());
+                    }
+                }
+                a
+            })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+        /// Exit 0 or 2, one message on 2, never a panic or an abort, within
+        /// 20 s and 2 GB of address space.
+        #[test]
+        fn scene_flags_end_in_0_or_a_message(args in flags()) {
+            let line = format!(
+                "ulimit -v 2000000; exec {} bench --steps 0 {}",
+                assert_cmd::cargo::cargo_bin("ballpit").display(),
+                args.join(" ")
+            );
+            let out = std::process::Command::new("sh").args(["-c", &line]).output().unwrap();
+            let code = out.status.code();
+            let err = String::from_utf8_lossy(&out.stderr);
+            prop_assert!(matches!(code, Some(0 | 2)), "{args:?}: {code:?} {err}");
+            prop_assert!(!err.contains("panicked"), "{args:?}: {err}");
+            if code == Some(2) {
+                // Ours: one line; clap's: one line and its `--help` hint.
+                let first = err.lines().next().unwrap_or("");
+                prop_assert!(
+                    first.starts_with("ballpit: ") || first.starts_with("error: "),
+                    "{:?}: {}", args, err
+                );
+                prop_assert!(err.lines().filter(|l| l.starts_with("ballpit: ") || l.starts_with("error: ")).count() == 1, "{:?}: {}", args, err);
+            }
+        }
+
+        /// Any bytes as a CSV or TOML scene: a world or a message, no panic.
+        #[test]
+        fn scene_files_parse_or_say_why(
+            rows in proptest::collection::vec(
+                proptest::collection::vec(one_of(&[
+                    "0.5", "0.1", "0.2", "0", "-1", "1e308", "NaN", "", "x", "0.5 ", "1e-320",
+                ]), 0..10),
+                0..6),
+            crlf in any::<bool>(),
+        ) {
+            let nl = if crlf { "\r\n" } else { "\n" };
+            let mut text = format!("x,y,z,vx,vy,vz,radius,mass{nl}");
+            for r in &rows {
+                text.push_str(&r.join(","));
+                text.push_str(nl);
+            }
+            match csv_io::parse(&text, 1.0, "f.csv") {
+                Ok(w) => {
+                    prop_assert_eq!(w.escaped(), 0);
+                    prop_assert_eq!(w.max_overlap_rel(), 0.0);
+                }
+                Err(e) => prop_assert!(e.0.starts_with("f.csv"), "{}", e),
+            }
+            let toml: String = rows
+                .iter()
+                .map(|r| format!("[[sphere]]{nl}pos = [{}]{nl}radius = {}{nl}", r.join(", "), r.first().copied().unwrap_or("")))
+                .collect();
+            if let Err(e) = toml_file::parse(&toml, "f.toml") {
+                prop_assert!(e.0.starts_with("f.toml"), "{}", e);
+            }
+        }
+    }
+}
