@@ -32,6 +32,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 .tick
                 .unwrap_or_else(|| args.steps.div_ceil(100).clamp(1, u64::from(u32::MAX)) as u32);
             let world = scene::build_world(&args.scene.spec())?;
+            fits(world.spheres.len(), Some(settings.model))?;
             let dump = args
                 .dump
                 .as_deref()
@@ -51,6 +52,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         None => {
             let settings = cli.run.settings()?;
             let world = scene::build_world(&cli.scene.spec())?;
+            // The app can switch to any model: plan for the hungriest.
+            fits(world.spheres.len(), None)?;
             let color = match cli.color.as_deref() {
                 None => ballpit::tui::ColorChoice::Auto,
                 Some(c) => c.parse().map_err(BadInput)?,
@@ -62,4 +65,11 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             ballpit::tui::run(world, settings, opts)
         }
     }
+}
+
+/// Refuse a world the machine has no memory for, before the model builds
+/// its structures.
+fn fits(count: usize, model: Option<ballpit::physics::ModelKind>) -> Result<(), BadInput> {
+    use ballpit::memory;
+    memory::check(count, model, memory::available()).map_err(BadInput)
 }

@@ -173,6 +173,32 @@ fn tempdir() -> std::path::PathBuf {
     d
 }
 
+#[test]
+fn a_count_the_memory_cannot_hold_is_refused_with_the_figure() {
+    // Under a 1 GB address-space limit: 400 000 spheres need about 0.6 GB with
+    // exact, more than half the limit, so they are refused before the model allocates anything.
+    let run = |model: &str| {
+        let line = format!(
+            "ulimit -v 1000000; exec {} bench --count 400000 --radius 0.001 --model {model} --steps 0",
+            assert_cmd::cargo::cargo_bin("ballpit").display()
+        );
+        std::process::Command::new("sh")
+            .args(["-c", &line])
+            .output()
+            .unwrap()
+    };
+    let out = run("exact");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.starts_with("ballpit: 400000 spheres would need about 6") && err.contains("with exact"),
+        "{err}"
+    );
+    let toml: String = "[[sphere]]\npos = [0.5, 0.5, 0.5]\nradius = 0.001\n".repeat(100_001);
+    let e = toml_file::parse(&toml, "big.toml").unwrap_err();
+    assert!(e.0.contains("100001 [[sphere]] entries"), "{e}");
+}
+
 mod fuzz {
     use super::*;
     use proptest::prelude::*;

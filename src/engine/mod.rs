@@ -324,6 +324,12 @@ impl Engine {
                     frame.model = m.build();
                 }
                 Command::SetCount(n) => {
+                    // Any model may run next: plan for the hungriest.
+                    let fits = crate::memory::check(n, None, crate::memory::available());
+                    if let (true, Err(e)) = (n > frame.world.spheres.len(), fits) {
+                        frame.notice = Some(format!("count limit: {e}"));
+                        continue;
+                    }
                     let w = &mut frame.world;
                     let radius = edit::typical_radius(w)
                         .or_else(|| edit::typical_radius(&self.initial))

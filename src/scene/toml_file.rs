@@ -56,7 +56,17 @@ pub fn read(path: &Path) -> Result<SceneFile, BadInput> {
     parse(&text, &path.display().to_string())
 }
 
+/// Most `[[sphere]]` entries a TOML scene may hold: parsing TOML takes
+/// about 3 KB a sphere, a CSV under a tenth of that.
+pub const MAX_SPHERES: usize = 100_000;
+
 pub fn parse(text: &str, name: &str) -> Result<SceneFile, BadInput> {
+    let entries = text.matches("[[sphere]]").count();
+    if entries > MAX_SPHERES {
+        return bad!(
+            "{name}: {entries} [[sphere]] entries; a TOML scene holds at most {MAX_SPHERES} (parsing takes about 3 KB a sphere): give that many spheres as a CSV"
+        );
+    }
     toml::from_str(text).or_else(|e: toml::de::Error| {
         let line = e.span().map(|s| super::line_of(text, s.start));
         let msg = e.message().to_string();
