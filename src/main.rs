@@ -3,7 +3,7 @@ use ballpit::cli::{Cli, Command};
 use ballpit::error::BadInput;
 use ballpit::{bench, scene};
 use clap::CommandFactory;
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -68,9 +68,18 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             Ok(emit(&page)?)
         }
         None => {
-            // Flags first, then the scene: a bad flag is told before any work.
+            // Flags, then the terminal, then the scene: nothing is built for
+            // a screen that cannot open.
             let settings = cli.run.settings()?;
             let opts = cli.options();
+            if !(std::io::stdin().is_terminal() && std::io::stdout().is_terminal()) {
+                return Err(BadInput(
+                    "ballpit's screen needs a terminal, but stdin or stdout is not one; \
+                     for a headless run use `ballpit bench`"
+                        .into(),
+                )
+                .into());
+            }
             let world = scene::build_world(&cli.scene.spec())?;
             ballpit::tui::run(world, settings, opts)
         }

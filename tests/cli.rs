@@ -462,3 +462,18 @@ fn output_that_cannot_be_written_is_reported_not_a_panic() {
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("cannot write to stdout"), "{err}");
 }
+
+#[test]
+fn without_a_terminal_nothing_is_built_first() {
+    // This scene would take minutes and gigabytes to place; the app must say
+    // it needs a terminal before building it.
+    let out = ballpit()
+        .args(["--scene", "dense", "--count", "10", "--radius", "0.0001"])
+        .write_stdin("")
+        .timeout(std::time::Duration::from_secs(10))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("needs a terminal"), "{err}");
+}
