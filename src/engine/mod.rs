@@ -30,7 +30,7 @@ use std::str::FromStr;
 use std::sync::Arc;
 use worker::Worker;
 
-/// Where the physics runs (DESIGN.md, Threading).
+/// Where the physics runs (docs/design.md, Threading).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Threading {
     Off,
