@@ -40,7 +40,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 .run
                 .tick
                 .unwrap_or_else(|| args.steps.div_ceil(100).clamp(1, u64::from(u32::MAX)) as u32);
-            let world = scene::build_world(&args.scene.spec())?;
+            let world = scene::build_world_for(&args.scene.spec(), Some(settings.model))?;
             fits(world.spheres.len(), Some(settings.model))?;
             let dump = args
                 .dump
@@ -50,6 +50,13 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let (report, world) = bench::run(world, &settings, args.steps)?;
             if let Some(file) = dump {
                 file.write(&world)?;
+                if world.max_overlap_rel() > 0.0 {
+                    // Not an error: discrete makes overlaps. Say how it reads back.
+                    let _ = writeln!(
+                        std::io::stderr(),
+                        "ballpit: note: the dump holds overlapping spheres; it loads back with --model discrete"
+                    );
+                }
             }
             let line = serde_json::to_string(&report)? + "\n";
             Ok(emit(line.as_bytes())?)
@@ -81,7 +88,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 )
                 .into());
             }
-            let world = scene::build_world(&cli.scene.spec())?;
+            let world = scene::build_world_for(&cli.scene.spec(), Some(settings.model))?;
             // The app can switch to any model: plan for the hungriest.
             fits(world.spheres.len(), None)?;
             ballpit::tui::run(world, settings, opts)

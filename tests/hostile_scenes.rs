@@ -199,6 +199,30 @@ fn a_count_the_memory_cannot_hold_is_refused_with_the_figure() {
     assert!(e.0.contains("100001 [[sphere]] entries"), "{e}");
 }
 
+#[test]
+fn a_discrete_dump_reads_back_with_discrete_and_says_so() {
+    let dir = tempdir();
+    let dump = dir.join("d.csv");
+    let path = dump.to_str().unwrap();
+    // A crowded scene at a long step: discrete leaves overlaps.
+    let out = ballpit()
+        .args([
+            "bench", "--model", "discrete", "--count", "2000", "--radius", "0.03",
+        ])
+        .args(["--dt", "0.1", "--steps", "20", "--dump", path])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("loads back with --model discrete"), "{err}");
+    let (code, err) = bench(&["--scene", path, "--model", "discrete"]);
+    assert_eq!(code, 0, "{err}");
+    refused(
+        &["--scene", path, "--model", "swept"],
+        "(only --model discrete takes overlapping spheres)",
+    );
+}
+
 mod fuzz {
     use super::*;
     use proptest::prelude::*;

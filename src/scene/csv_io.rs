@@ -1,7 +1,7 @@
 //! Sphere CSV: header `x,y,z,vx,vy,vz,radius,mass`, one sphere a row.
 //! Numbers are written in Rust's shortest round-trip form, so a dump reads
 //! back bit for bit.
-use super::place::check;
+use super::place::{Overlaps, check_with};
 use crate::error::BadInput;
 use crate::physics::{Sphere, World};
 use crate::{bad, bad_input};
@@ -11,14 +11,24 @@ use std::path::Path;
 
 pub const HEADER: [&str; 8] = ["x", "y", "z", "vx", "vy", "vz", "radius", "mass"];
 
-pub fn read(path: &Path, size: f64) -> Result<World, BadInput> {
+pub fn read(path: &Path, size: f64, overlaps: Overlaps) -> Result<World, BadInput> {
     let name = path.display().to_string();
     let text = super::read_text(path)?;
-    parse(&text, size, &name)
+    parse_with(&text, size, &name, overlaps)
 }
 
 /// Parse CSV text; `name` prefixes every message (`file.csv line 7: ...`).
 pub fn parse(text: &str, size: f64, name: &str) -> Result<World, BadInput> {
+    parse_with(text, size, name, Overlaps::Refuse)
+}
+
+/// [`parse`], with overlapping spheres refused or allowed.
+pub fn parse_with(
+    text: &str,
+    size: f64,
+    name: &str,
+    overlaps: Overlaps,
+) -> Result<World, BadInput> {
     let mut rdr = csv::ReaderBuilder::new()
         .has_headers(true)
         .trim(csv::Trim::All)
@@ -73,7 +83,7 @@ pub fn parse(text: &str, size: f64, name: &str) -> Result<World, BadInput> {
         lines.push(line);
     }
     let world = World::new(size, spheres);
-    check(&world, name, &|i| format!("line {}", lines[i]))?;
+    check_with(&world, overlaps, name, &|i| format!("line {}", lines[i]))?;
     Ok(world)
 }
 

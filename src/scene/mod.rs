@@ -7,7 +7,7 @@ pub mod toml_file;
 
 use crate::error::BadInput;
 use crate::physics::sphere::volume;
-use crate::physics::{Sphere, World};
+use crate::physics::{ModelKind, Sphere, World};
 use crate::{bad, bad_input};
 use glam::DVec3;
 use std::path::Path;
@@ -77,6 +77,17 @@ pub(crate) fn line_of(text: &str, at: usize) -> usize {
 
 /// Build the world a spec describes, or say what is wrong with it.
 pub fn build_world(spec: &SceneSpec) -> Result<World, BadInput> {
+    build_world_for(spec, None)
+}
+
+/// [`build_world`] for a run that starts with `model`: `discrete` takes a
+/// scene file with overlapping spheres (as its own `--dump` may hold).
+pub fn build_world_for(spec: &SceneSpec, model: Option<ModelKind>) -> Result<World, BadInput> {
+    let overlaps = if model == Some(ModelKind::Discrete) {
+        place::Overlaps::Allow
+    } else {
+        place::Overlaps::Refuse
+    };
     if let Some(size) = spec.size {
         length("--box", size)?;
     }
@@ -85,7 +96,7 @@ pub fn build_world(spec: &SceneSpec) -> Result<World, BadInput> {
         if spec.count.is_some() || spec.radius.is_some() || spec.speed.is_some() {
             return bad!("--count, --radius and --speed do not apply to a CSV scene ({scene})");
         }
-        return csv_io::read(Path::new(scene), spec.size.unwrap_or(1.0));
+        return csv_io::read(Path::new(scene), spec.size.unwrap_or(1.0), overlaps);
     }
     let (file, merged) = if scene.ends_with(".toml") {
         let f = toml_file::read(Path::new(scene))?;
@@ -131,7 +142,7 @@ pub fn build_world(spec: &SceneSpec) -> Result<World, BadInput> {
             })
             .collect();
         let world = World::new(size, spheres);
-        place::check(&world, name, &|i| format!("sphere {}", i + 1))?;
+        place::check_with(&world, overlaps, name, &|i| format!("sphere {}", i + 1))?;
         return Ok(world);
     }
     let name = merged.scene.as_deref().unwrap_or("gas");

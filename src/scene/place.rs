@@ -225,11 +225,31 @@ fn pick_sites(per_side: usize, n: usize, rng: &mut SceneRng) -> Vec<usize> {
     }
 }
 
+/// Whether a scene may hold overlapping spheres: only for `discrete`, which
+/// makes them itself (so its `--dump` reads back), never for the models that
+/// promise none.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Overlaps {
+    #[default]
+    Refuse,
+    Allow,
+}
+
 /// Why a world is not a valid scene, if it isn't: centres outside the cube,
 /// overlaps, non-finite or non-positive values. `source` names the file (or
 /// what made the scene) once; `item(i)` names sphere `i` in it (e.g. its CSV
 /// line).
 pub fn check(world: &World, source: &str, item: &dyn Fn(usize) -> String) -> Result<(), BadInput> {
+    check_with(world, Overlaps::Refuse, source, item)
+}
+
+/// [`check`], with overlaps refused or allowed.
+pub fn check_with(
+    world: &World,
+    overlaps: Overlaps,
+    source: &str,
+    item: &dyn Fn(usize) -> String,
+) -> Result<(), BadInput> {
     let what = |i: usize| format!("{source} {}", item(i));
     let size = world.size;
     let tol = 1e-9 * size;
@@ -268,17 +288,14 @@ pub fn check(world: &World, source: &str, item: &dyn Fn(usize) -> String) -> Res
             }
         }
     }
-    let mut first: Option<(usize, usize, f64)> = None;
-    crate::physics::broad::for_each_near_pair(&world.spheres, size, |i, j| {
-        let (a, b) = (&world.spheres[i], &world.spheres[j]);
-        let sum = a.radius + b.radius;
-        let d = a.pos.distance(b.pos);
-        if d < sum * (1.0 - 1e-12) && first.is_none_or(|f| (i.min(j), i.max(j)) < (f.0, f.1)) {
-            first = Some((i.min(j), i.max(j), sum - d));
-        }
-    });
-    if let Some((i, j, depth)) = first {
-        return bad!("{source}: {} and {} overlap by {depth}", item(i), item(j));
+    if overlaps == Overlaps::Refuse
+        && let Some((i, j, depth)) = first_overlap(world)
+    {
+        return bad!(
+            "{source}: {} and {} overlap by {depth} (only --model discrete takes overlapping spheres)",
+            item(i),
+            item(j)
+        );
     }
     if !world.kinetic_energy().is_finite() {
         return bad!(
@@ -286,6 +303,20 @@ pub fn check(world: &World, source: &str, item: &dyn Fn(usize) -> String) -> Res
         );
     }
     Ok(())
+}
+
+/// The overlapping pair with the lowest indices, and its depth.
+fn first_overlap(world: &World) -> Option<(usize, usize, f64)> {
+    let mut first: Option<(usize, usize, f64)> = None;
+    crate::physics::broad::for_each_near_pair(&world.spheres, world.size, |i, j| {
+        let (a, b) = (&world.spheres[i], &world.spheres[j]);
+        let sum = a.radius + b.radius;
+        let d = a.pos.distance(b.pos);
+        if d < sum * (1.0 - 1e-12) && first.is_none_or(|f| (i.min(j), i.max(j)) < (f.0, f.1)) {
+            first = Some((i.min(j), i.max(j), sum - d));
+        }
+    });
+    first
 }
 
 /// Whether a sphere's speed leaves the physics finite numbers: times of
