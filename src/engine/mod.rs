@@ -346,6 +346,7 @@ impl Engine {
                 }
                 Command::Reset => {
                     frame.world = self.initial.clone();
+                    frame.world.touch();
                     frame.model = self.settings.model.build();
                     frame.notice = None;
                     frame.energy_reset = frame.world.kinetic_energy();
@@ -359,6 +360,7 @@ impl Engine {
 
     /// The spheres changed from outside the model.
     fn edited(&self, frame: &mut Frame) {
+        frame.world.touch();
         frame.model.invalidate();
         frame.energy_reset = frame.world.kinetic_energy();
     }
