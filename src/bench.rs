@@ -9,7 +9,7 @@ pub struct ThreadCpu {
     pub cpu_seconds: f64,
 }
 
-/// The fields of DESIGN.md's bench JSON, plus `physics_threads`,
+/// The fields of docs/design.md's bench JSON, plus `physics_threads`,
 /// `load_average`, `collisions_per_sim_second`, `temperature` and
 /// `capped_steps`.
 #[derive(Debug, Serialize)]

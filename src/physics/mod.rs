@@ -10,6 +10,7 @@ pub mod exec;
 pub mod flight;
 pub mod model;
 pub mod reference;
+pub mod relax;
 pub mod sphere;
 pub mod swept;
 pub mod world;
