@@ -9,8 +9,9 @@ pub struct ThreadCpu {
     pub cpu_seconds: f64,
 }
 
-/// The fields of docs/design.md's bench JSON, plus `capped_steps`,
-/// `temperature` and `collisions_per_second`.
+/// The fields of docs/design.md's bench JSON, plus `physics_threads`,
+/// `load_average`, `collisions_per_sim_second`, `temperature` and
+/// `capped_steps`.
 #[derive(Debug, Serialize)]
 pub struct BenchReport {
     pub n: usize,
@@ -21,7 +22,18 @@ pub struct BenchReport {
     pub threads: usize,
     /// The threads the physics really ran on (the driver first).
     pub physics_threads: Vec<String>,
+    /// Wall time of the physics: every frame's steps and the detection
+    /// behind its overlap readout (not the copy of the spheres for it).
     pub wall_seconds: f64,
+    /// CPU seconds the `physics_threads` ran while stepping (all of their
+    /// time then, the snapshots' copies included; pool threads' spinning
+    /// between sections too). Read from schedstat: exact for threads that
+    /// sleep between frames, up to the last scheduler tick for the caller
+    /// in `off`.
+    pub physics_cpu_seconds: f64,
+    /// The 1-minute load average of the host (`/proc/loadavg`) before and
+    /// after stepping, so a reader can judge the timings; empty elsewhere.
+    pub load_average: Vec<f64>,
     pub steps_per_second: f64,
     pub sphere_steps_per_second: f64,
     pub energy_start: f64,
@@ -33,7 +45,8 @@ pub struct BenchReport {
     pub sphere_collisions: u64,
     pub wall_collisions: u64,
     pub wall_pressure: f64,
-    pub collisions_per_second: f64,
+    /// Sphere–sphere collisions per simulated second.
+    pub collisions_per_sim_second: f64,
     pub temperature: f64,
     pub capped_steps: u64,
     pub thread_cpu: Vec<ThreadCpu>,
@@ -62,6 +75,16 @@ pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(Ben
             ..*settings
         },
     )?;
+    let load_start = load_average();
+    // CPU already run by the threads that exist before stepping; threads
+    // born while stepping (pools) start from 0.
+    let mut cpu_before: Vec<(i32, f64)> = Vec::new();
+    for tid in [crate::cpu::current_tid(), engine.physics_tid()]
+        .into_iter()
+        .flatten()
+    {
+        cpu_before.push((tid, crate::cpu::thread_cpu_seconds_of(tid).unwrap_or(0.0)));
+    }
     let mut max_err: f64 = 0.0;
     let mut wall = 0.0;
     let mut done = 0;
@@ -76,8 +99,10 @@ pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(Ben
         max_err = max_err.max(rel(snap.energy));
         done += now;
     }
-    let world = engine.world().clone();
     let physics_threads = engine.physics_threads();
+    let physics_cpu_seconds = physics_cpu(&engine, &physics_threads, &cpu_before);
+    let load_end = load_average();
+    let world = engine.world().clone();
     // Read while the engine's threads are still alive.
     let thread_cpu = crate::cpu::thread_cpu_seconds()
         .into_iter()
@@ -99,6 +124,8 @@ pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(Ben
         threads: settings.threads,
         physics_threads,
         wall_seconds: wall,
+        physics_cpu_seconds,
+        load_average: load_start.into_iter().chain(load_end).collect(),
         steps_per_second: per_sec(steps as f64),
         sphere_steps_per_second: per_sec(steps as f64 * n as f64),
         energy_start: e0,
@@ -114,7 +141,7 @@ pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(Ben
         } else {
             0.0
         },
-        collisions_per_second: if sim > 0.0 {
+        collisions_per_sim_second: if sim > 0.0 {
             c.sphere_collisions as f64 / sim
         } else {
             0.0
@@ -125,6 +152,33 @@ pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(Ben
         peak_rss_bytes: peak_rss_bytes(),
     };
     Ok((report, world))
+}
+
+/// CPU seconds the threads named in `names` ran since `before` (by
+/// thread id; a thread not in it started later, from 0).
+fn physics_cpu(engine: &Engine, names: &[String], before: &[(i32, f64)]) -> f64 {
+    let caller = std::thread::current().name().unwrap_or("main").to_string();
+    let threads = engine
+        .thread_ids()
+        .into_iter()
+        .chain(crate::cpu::current_tid().map(|t| (caller, t)));
+    threads
+        .filter(|(name, _)| names.contains(name))
+        .map(|(_, tid)| {
+            let start = before.iter().find(|b| b.0 == tid).map_or(0.0, |b| b.1);
+            crate::cpu::thread_cpu_seconds_of(tid).map_or(0.0, |now| now - start)
+        })
+        .sum()
+}
+
+/// The 1-minute load average (Linux), `None` elsewhere.
+fn load_average() -> Option<f64> {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
 }
 
 /// `VmHWM` of this process (0 where /proc is not there).

@@ -1,20 +1,22 @@
-//! `ballpit tradeoff`: every model over a ladder of `dt`, measured against the
-//! exact model on the same scene. All models run on one thread here, so the
-//! costs compare algorithms, not thread counts.
+//! `ballpit tradeoff`: every model over a ladder of `dt`, measured against
+//! an independent reference on the same scene: the brute-force event-driven
+//! run of `physics::reference` (every pair tested at every event; none of
+//! the models' code). All models run on one thread here, so the costs
+//! compare algorithms, not thread counts.
 //!
 //! Measures, per model and `dt`, over [`RUN_SECONDS`] of simulated time:
 //! cost (wall seconds per simulated second, sphere-steps per second), worst
 //! relative energy error, deepest overlap (per smaller radius, worst over
 //! the steps), spheres escaped (worst over the steps), and sphere–sphere
-//! collisions missed relative to `exact` over the same time. Then the
-//! position error against `exact` at a short horizon: a quarter of the mean
-//! free time (from the exact run), rounded up to whole steps. Before that
-//! time a typical sphere has not collided yet, so the difference comes from
-//! how the model handles the few contacts that do happen, not from chaos:
-//! each collision multiplies a small position difference by about the mean
-//! free path over the diameter, so after a few collisions per sphere any two
-//! runs (even `exact` against itself with another `dt`) differ by the box.
-use crate::physics::{ModelKind, Serial, World};
+//! collisions missed relative to the reference over the same time. Then the
+//! position error against the reference at a short horizon: a quarter of
+//! the mean free time (from the reference run), rounded up to whole steps.
+//! Before that time a typical sphere has not collided yet, so the
+//! difference comes from how the model handles the few contacts that do
+//! happen, not from chaos: each collision multiplies a small position
+//! difference by about the mean free path over the diameter, so after a few
+//! collisions per sphere any two runs differ by the box.
+use crate::physics::{ModelKind, Serial, World, reference};
 use anyhow::Context;
 use plotters::prelude::*;
 use std::fmt::Write as _;
@@ -47,10 +49,10 @@ pub struct Row {
     pub max_overlap_rel: f64,
     pub escaped: usize,
     pub collisions: u64,
-    /// `1 - collisions / exact collisions` (negative: counted more than exact).
+    /// `1 - collisions / reference collisions` (negative: counted more).
     pub missed: f64,
     pub horizon: f64,
-    /// RMS distance to the exact positions at `horizon`, in box lengths.
+    /// RMS distance to the reference positions at `horizon`, in box lengths.
     pub pos_err: f64,
     pub capped_steps: u64,
 }
@@ -59,9 +61,7 @@ pub struct Row {
 pub fn measure(world: &World) -> Vec<Row> {
     let reference = {
         let mut w = world.clone();
-        let mut m = ModelKind::Exact.build();
-        let steps = (RUN_SECONDS * 60.0).round() as u64;
-        m.advance(&mut w, RUN_SECONDS / steps as f64, steps, &Serial);
+        reference::run(&mut w, RUN_SECONDS);
         w.counters.sphere_collisions
     };
     let n = world.spheres.len();
@@ -71,18 +71,27 @@ pub fn measure(world: &World) -> Vec<Row> {
         f64::INFINITY
     };
     let horizon = (free_time / 4.0).min(RUN_SECONDS / 8.0);
+    // The reference at each dt's horizon (a whole number of its steps).
+    let at_horizon: Vec<(u64, World)> = LADDER
+        .iter()
+        .map(|&dt| {
+            let steps = (horizon / dt).ceil().max(1.0) as u64;
+            let mut w = world.clone();
+            reference::run(&mut w, steps as f64 * dt);
+            (steps, w)
+        })
+        .collect();
     let mut rows = Vec::new();
     for model in ModelKind::ALL {
-        for dt in LADDER {
+        for (dt, (steps_h, truth)) in LADDER.into_iter().zip(&at_horizon) {
             let mut row = run_one(world, model, dt);
             row.missed = if reference > 0 {
                 1.0 - row.collisions as f64 / reference as f64
             } else {
                 0.0
             };
-            let steps_h = (horizon / dt).ceil().max(1.0) as u64;
-            row.pos_err = position_error(world, model, dt, steps_h);
-            row.horizon = steps_h as f64 * dt;
+            row.pos_err = position_error(world, model, dt, *steps_h, truth);
+            row.horizon = *steps_h as f64 * dt;
             rows.push(row);
         }
     }
@@ -127,13 +136,10 @@ fn run_one(world: &World, kind: ModelKind, dt: f64) -> Row {
     }
 }
 
-fn position_error(world: &World, kind: ModelKind, dt: f64, steps: u64) -> f64 {
-    let run = |k: ModelKind| {
-        let mut w = world.clone();
-        k.build().advance(&mut w, dt, steps, &Serial);
-        w
-    };
-    let (a, b) = (run(kind), run(ModelKind::Exact));
+fn position_error(world: &World, kind: ModelKind, dt: f64, steps: u64, truth: &World) -> f64 {
+    let mut a = world.clone();
+    kind.build().advance(&mut a, dt, steps, &Serial);
+    let b = truth;
     if a.spheres.is_empty() {
         return 0.0;
     }
@@ -150,8 +156,13 @@ fn dt_label(dt: f64) -> String {
     format!("1/{}", (1.0 / dt).round())
 }
 
+/// What the errors are measured against, said above the table.
+pub const REFERENCE_NOTE: &str = "Errors against the reference: a brute-force event-driven run \
+(every pair tested at every event, src/physics/reference.rs), not any of the models.";
+
 pub fn markdown(rows: &[Row]) -> String {
-    let mut s = String::from(
+    let mut s = format!("{REFERENCE_NOTE}\n\n");
+    s.push_str(
         "| model | dt | wall s / sim s | sphere-steps/s | energy err | deepest overlap (r) | escaped | collisions missed | pos err (L) at horizon |\n\
          |---|---|---:|---:|---:|---:|---:|---:|---:|\n",
     );

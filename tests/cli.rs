@@ -26,6 +26,9 @@ fn bench_prints_one_json_line_with_every_field() {
         "threading",
         "threads",
         "wall_seconds",
+        "physics_cpu_seconds",
+        "load_average",
+        "collisions_per_sim_second",
         "steps_per_second",
         "sphere_steps_per_second",
         "energy_start",
@@ -49,6 +52,7 @@ fn bench_prints_one_json_line_with_every_field() {
     assert_eq!(v["escaped"], 0);
     assert!(v["energy_drift_rel"].as_f64().unwrap() < 1e-12);
     assert!(v["peak_rss_bytes"].as_u64().unwrap() > 0);
+    assert_eq!(v["load_average"].as_array().unwrap().len(), 2);
 }
 
 #[test]
@@ -232,7 +236,7 @@ fn bench_runs_every_threading_mode_to_the_same_bits() {
     for (mode, first) in [
         ("off", "main"),
         ("worker", "physics"),
-        ("pool", "physics"),
+        ("pool", "pool-0"),
         ("split", "physics"),
     ] {
         let path = dir.join(format!("{mode}.csv"));
@@ -254,6 +258,11 @@ fn bench_runs_every_threading_mode_to_the_same_bits() {
         ]);
         assert_eq!(v["threading"], mode);
         assert_eq!(v["physics_threads"][0], first, "{mode}");
+        if mode != "off" {
+            // Threads that sleep between frames have their CPU time read
+            // exactly (a running caller's only to the last scheduler tick).
+            assert!(v["physics_cpu_seconds"].as_f64().unwrap() > 0.0, "{mode}");
+        }
         assert!(v["sphere_collisions"].as_u64().unwrap() > 0);
         let names: Vec<&str> = v["thread_cpu"]
             .as_array()

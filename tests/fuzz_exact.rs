@@ -211,7 +211,29 @@ proptest! {
                     prop_assert!(x.max_overlap_rel() <= 1e-9);
                 }
             }
-            Err(e) => prop_assert!(!e.0.is_empty()),
+            Err(e) => {
+                // One line, naming what is wrong, checked in the order the
+                // loader meets it: the file's fields, the preset, the
+                // values, then whether the spheres fit.
+                let msg = &e.0;
+                prop_assert_eq!(msg.lines().count(), 1, "{}", msg);
+                let want: &[&str] = if extra == 1 {
+                    &["colour"]
+                } else if extra == 2 {
+                    // Explicit spheres replace the preset's: the sphere or
+                    // the box it does not fit.
+                    &["sphere 1", "box"]
+                } else if preset == "nope" {
+                    &["'nope'"]
+                } else if radius.is_some_and(|r| r <= 0.0) {
+                    &["radius"]
+                } else if speed.is_some_and(|v| v < 0.0) {
+                    &["speed"]
+                } else {
+                    &["cannot fit", "too big", "needs", "outside the cube"]
+                };
+                prop_assert!(want.iter().any(|w| msg.contains(w)), "{:?} not in: {}", want, msg);
+            }
         }
     }
 }

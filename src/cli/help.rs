@@ -15,7 +15,18 @@ pub const BENCH_FIELDS: &[(&str, &str)] = &[
         "physics_threads",
         "the threads the physics ran on, driver first",
     ),
-    ("wall_seconds", "wall time of the stepping only"),
+    (
+        "wall_seconds",
+        "wall time of the physics: the steps and the detection behind the overlap readout",
+    ),
+    (
+        "physics_cpu_seconds",
+        "CPU time of the physics_threads while stepping",
+    ),
+    (
+        "load_average",
+        "[start, end] 1-minute load average of the host (/proc/loadavg)",
+    ),
     ("steps_per_second", "steps / wall_seconds"),
     ("sphere_steps_per_second", "n x steps / wall_seconds"),
     ("energy_start", "kinetic energy at the start"),
@@ -43,7 +54,7 @@ pub const BENCH_FIELDS: &[(&str, &str)] = &[
         "momentum given to the walls / (simulated time x wall area)",
     ),
     (
-        "collisions_per_second",
+        "collisions_per_sim_second",
         "sphere_collisions per simulated second",
     ),
     ("temperature", "mean kinetic energy per sphere, 2/3 x E/n"),

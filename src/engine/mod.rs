@@ -6,9 +6,10 @@
 //! `settings`, `world`.
 //!
 //! Threads: `physics` (created with the engine, asleep on a channel until a
-//! frame is handed to it) drives every threaded mode; `pool` lends it
-//! `pool-0..K-1` for the data-parallel sections, `split` lends it
-//! `split-pair` and `split-wall` for the two functional jobs. The physics
+//! frame is handed to it) takes every threaded frame; in `pool` it hands the
+//! frame on to `pool-0..K-1`, which run it and its data-parallel sections
+//! while `physics` sleeps; `split` lends it `split-pair` and `split-wall`
+//! for the two functional jobs. The physics
 //! cuts its work into fixed blocks combined in block order, so every mode
 //! gives the same bits. The frame (world, model, executor, back snapshot)
 //! moves whole to the thread that runs it and back, so no lock guards the
@@ -275,23 +276,26 @@ impl Engine {
     }
 
     /// The threads the current settings put physics work on, driver first.
-    /// A model that runs one event loop (`exact`) ignores the executor, so
-    /// in `pool` and `split` it runs on `physics` alone.
+    /// In `pool` the frame itself runs on a pool thread (rayon picks which)
+    /// while `physics` sleeps until it is done, so only the pool threads are
+    /// named. A model that runs one event loop (`exact`) ignores the
+    /// executor's lanes, so in `split` it runs on `physics` alone.
     pub fn physics_threads(&self) -> Vec<String> {
-        let helpers: Vec<String> = match self.settings.threading {
+        match self.settings.threading {
             Threading::Off => {
-                return vec![std::thread::current().name().unwrap_or("main").to_string()];
+                vec![std::thread::current().name().unwrap_or("main").to_string()]
             }
-            _ if self.settings.model.name() == "exact" => Vec::new(),
-            Threading::Worker => Vec::new(),
             Threading::Pool => (0..self.settings.threads)
                 .map(|i| format!("pool-{i}"))
                 .collect(),
-            Threading::Split => SPLIT_NAMES.map(String::from).to_vec(),
-        };
-        std::iter::once("physics".to_string())
-            .chain(helpers)
-            .collect()
+            Threading::Split if self.settings.model != ModelKind::Exact => {
+                std::iter::once("physics")
+                    .chain(SPLIT_NAMES)
+                    .map(String::from)
+                    .collect()
+            }
+            Threading::Worker | Threading::Split => vec!["physics".to_string()],
+        }
     }
 
     fn check(&self) -> anyhow::Result<()> {
@@ -348,6 +352,7 @@ impl Engine {
                 }
                 Command::Reset => {
                     frame.world = self.initial.clone();
+                    frame.world.touch();
                     frame.model = self.settings.model.build();
                     frame.notice = None;
                     frame.energy_reset = frame.world.kinetic_energy();
@@ -361,6 +366,7 @@ impl Engine {
 
     /// The spheres changed from outside the model.
     fn edited(&self, frame: &mut Frame) {
+        frame.world.touch();
         frame.model.invalidate();
         frame.energy_reset = frame.world.kinetic_energy();
     }

@@ -4,7 +4,7 @@ use super::Settings;
 use crate::physics::broad::{Grid, Pair};
 use crate::physics::exec::for_each_chunk;
 use crate::physics::world::escapes;
-use crate::physics::{Counters, Exec, Model, World};
+use crate::physics::{Counters, Exec, World};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Spheres per parallel block when copying them out.
@@ -33,7 +33,8 @@ pub struct Snapshot {
     pub counters: Counters,
     /// Parts the model cut its last step into (1: whole).
     pub parts: u32,
-    /// Wall-clock seconds the physics of this frame took.
+    /// Wall-clock seconds the physics of this frame took: its steps and the
+    /// detection behind `max_overlap_rel`.
     pub physics_seconds: f64,
     /// Steps run in this frame.
     pub steps: u64,
@@ -62,21 +63,19 @@ impl Snapshot {
             settings,
             notice: None,
         };
-        s.fill_world(
-            world,
-            None,
-            &mut OverlapScratch::default(),
-            &crate::physics::Serial,
-        );
+        let serial = crate::physics::Serial;
+        let overlap = OverlapScratch::default().max_overlap_rel(world, &serial);
+        s.fill_world(world, 1, overlap, &serial);
         s
     }
 
-    /// Copy what the screen needs out of `world`, reusing the buffers.
+    /// Copy what the screen needs out of `world`, reusing the buffers; the
+    /// parts and the overlap come from the frame's timed work.
     pub(crate) fn fill_world(
         &mut self,
         world: &World,
-        model: Option<(&mut dyn Model, f64)>,
-        scratch: &mut OverlapScratch,
+        parts: u32,
+        max_overlap_rel: f64,
         exec: &dyn Exec,
     ) {
         self.time = world.time;
@@ -101,11 +100,8 @@ impl Snapshot {
             escaped.fetch_add(out, Ordering::Relaxed);
         });
         self.energy = world.kinetic_energy();
-        self.parts = model.as_ref().map_or(1, |(m, _)| m.last_parts());
-        // A model may know the overlap from its next step's detection.
-        self.max_overlap_rel = model
-            .and_then(|(m, dt)| m.max_overlap_rel(world, dt, exec))
-            .unwrap_or_else(|| scratch.max_overlap_rel(world, exec));
+        self.parts = parts;
+        self.max_overlap_rel = max_overlap_rel;
         self.escaped = escaped.into_inner();
         self.counters = world.counters;
     }
@@ -130,7 +126,7 @@ pub(crate) struct OverlapScratch {
 
 impl OverlapScratch {
     /// Same value as `World::max_overlap_rel`: the max is order-free.
-    fn max_overlap_rel(&mut self, world: &World, exec: &dyn Exec) -> f64 {
+    pub(crate) fn max_overlap_rel(&mut self, world: &World, exec: &dyn Exec) -> f64 {
         let sp = &world.spheres;
         self.grid.build(sp, world.size, |s| (s.pos, s.radius), exec);
         let overlapping = |i: u32, j: u32| {

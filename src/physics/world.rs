@@ -1,4 +1,13 @@
 use super::sphere::Sphere;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Hands out generations: a number is never given twice in a process, so a
+/// world replaced by another (a reset, a new scene) never looks unchanged.
+static NEXT_GENERATION: AtomicU64 = AtomicU64::new(1);
+
+fn next_generation() -> u64 {
+    NEXT_GENERATION.fetch_add(1, Ordering::Relaxed)
+}
 
 /// Running totals a model keeps while it steps; they feed the bench JSON and
 /// the screen.
@@ -14,13 +23,26 @@ pub struct Counters {
 }
 
 /// The cube `[0, size]^3` and the spheres in it.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct World {
     pub size: f64,
     pub spheres: Vec<Sphere>,
     /// Simulated time since the scene started.
     pub time: f64,
     pub counters: Counters,
+    /// Changes with every edit from outside a model (see `touch`).
+    generation: u64,
+}
+
+/// Two worlds are equal when what they hold is: the generation only tells
+/// a model whether the world it saw was edited since.
+impl PartialEq for World {
+    fn eq(&self, other: &World) -> bool {
+        self.size == other.size
+            && self.spheres == other.spheres
+            && self.time == other.time
+            && self.counters == other.counters
+    }
 }
 
 impl World {
@@ -30,7 +52,23 @@ impl World {
             spheres,
             time: 0.0,
             counters: Counters::default(),
+            generation: next_generation(),
         }
+    }
+
+    /// Announce an edit of the spheres from outside a model (added,
+    /// removed, resized, moved, given new velocities): every caller that
+    /// changes `spheres` other than a model's `advance` must call it, and
+    /// work a model kept for this world (`swept`'s detection made ahead for
+    /// the overlap readout) is then dropped.
+    pub fn touch(&mut self) {
+        self.generation = next_generation();
+    }
+
+    /// A number that changes with every `touch` and differs between worlds
+    /// made apart (clones share it until one of them is touched).
+    pub fn generation(&self) -> u64 {
+        self.generation
     }
 
     pub fn kinetic_energy(&self) -> f64 {

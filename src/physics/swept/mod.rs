@@ -64,12 +64,32 @@ pub struct Swept {
 
 /// A detection made ahead of its step (when the engine asked for the
 /// overlap of the world a frame ended with): valid for the world with this
-/// fingerprint and this `dt` only.
+/// key and this `dt` only.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Ahead {
     dt: f64,
-    print: u64,
+    key: WorldKey,
     overlap: f64,
+}
+
+/// What a detection made ahead is valid for: a world of this generation
+/// (bumped by every edit from outside, `World::touch`), at this time (a
+/// step by any model moves it), with this many spheres.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct WorldKey {
+    generation: u64,
+    time: u64,
+    count: usize,
+}
+
+impl WorldKey {
+    fn of(world: &World) -> WorldKey {
+        WorldKey {
+            generation: world.generation(),
+            time: world.time.to_bits(),
+            count: world.spheres.len(),
+        }
+    }
 }
 
 /// The ball a sphere on a straight path stays in during the step: centred
@@ -121,15 +141,15 @@ impl Model for Swept {
     fn max_overlap_rel(&mut self, world: &World, dt: f64, exec: &dyn Exec) -> Option<f64> {
         // The detection of the next step's first part.
         let dt = dt / f64::from(self.parts_of(world, dt));
-        let print = fingerprint(world);
+        let key = WorldKey::of(world);
         if let Some(a) = self.ahead
             && a.dt == dt
-            && a.print == print
+            && a.key == key
         {
             return Some(a.overlap);
         }
         let overlap = self.detect(world, dt, exec);
-        self.ahead = Some(Ahead { dt, print, overlap });
+        self.ahead = Some(Ahead { dt, key, overlap });
         Some(overlap)
     }
 }
@@ -167,7 +187,7 @@ impl Swept {
         let ready = self
             .ahead
             .take()
-            .is_some_and(|a| a.dt == dt && a.print == fingerprint(world));
+            .is_some_and(|a| a.dt == dt && a.key == WorldKey::of(world));
         if !ready {
             self.detect(world, dt, exec);
         }
@@ -276,29 +296,6 @@ impl Swept {
             .iter()
             .fold(0.0, |worst, d| worst.max(*d.lock()))
     }
-}
-
-/// Spheres the fingerprint samples.
-const PRINT_SAMPLES: usize = 64;
-
-/// A cheap mark of the world a detection was made for: its time, its count
-/// and a spread sample of spheres. Changes from outside must be announced
-/// with `Model::invalidate` (the engine does); this only catches a caller
-/// who hands a different world without doing so.
-fn fingerprint(world: &World) -> u64 {
-    let n = world.spheres.len();
-    let mut h = (n as u64) ^ world.time.to_bits().rotate_left(17) ^ world.size.to_bits();
-    for k in 0..PRINT_SAMPLES.min(n) {
-        let s = &world.spheres[k * n / PRINT_SAMPLES.min(n)];
-        for x in [
-            s.pos.x, s.pos.y, s.pos.z, s.vel.x, s.vel.y, s.vel.z, s.radius,
-        ] {
-            h = (h ^ x.to_bits())
-                .wrapping_mul(0x0100_0000_01b3)
-                .rotate_left(23);
-        }
-    }
-    h
 }
 
 /// Whether the straight path of `s` over `dt` leaves `[r, L - r]^3` (the
