@@ -67,6 +67,7 @@ fn report() -> CpuReport {
         ],
         total_percent: 99.5,
         cores: 2,
+        others_percent: Some(42.0),
     }
 }
 
