@@ -492,7 +492,7 @@ fn chart_view_has_a_line_per_thread_and_groups_many() {
     let t = screen(120, 40, &st, &r);
     insta::assert_snapshot!("chart_120x40_pool_2", t.backend());
     let text = rows(&t).join("\n");
-    assert!(text.contains("CPU per thread, last minute"), "{text}");
+    assert!(text.contains("CPU per thread, last 60 s"), "{text}");
     for name in ["main", "physics", "pool-0", "pool-1"] {
         assert!(text.contains(name), "{name}\n{text}");
     }

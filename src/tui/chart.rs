@@ -127,7 +127,10 @@ impl CpuChart<'_> {
 
 impl Widget for CpuChart<'_> {
     fn render(self, area: Rect, buf: &mut Buffer) {
-        let block = Block::bordered().title(" CPU per thread, last minute (c: spheres) ");
+        // Short enough for the 36 columns the canvas has at 80x24.
+        let block = Block::bordered()
+            .title(" CPU per thread, last 60 s ")
+            .title_bottom(" c: back to the spheres ");
         let inner = block.inner(area);
         block.render(area, buf);
         let lines = series(self.report);
