@@ -329,11 +329,11 @@ fn assert_every_thread_visible(text: &[String], r: &CpuReport, what: &str) {
                 let name: String = t.name.chars().take(11).collect();
                 assert!(all.contains(&name), "{what}: {name} missing\n{all}");
             }
-            let per_cell: usize = text[at]
-                .split(", ")
+            // "each cell: the busiest of K threads" when cells are shared.
+            let per_cell: usize = text[at + 1]
+                .split("busiest of ")
                 .nth(1)
-                .and_then(|s| s.split('/').next())
-                .map_or(1, |k| k.trim().parse().unwrap());
+                .map_or(1, |k| k.split(' ').next().unwrap().parse().unwrap());
             let cells: usize = text[at + 1..]
                 .iter()
                 .take_while(|l| !l.contains("total"))
@@ -590,4 +590,23 @@ fn others_line_shows_what_other_processes_take() {
             .any(|l| l.contains("other procs") && l.contains(" -  ")),
         "{text}"
     );
+}
+
+#[test]
+fn two_hundred_fifty_six_pool_threads_at_80x24_share_cells_and_say_so() {
+    let r = report_for(Threading::Pool, 256);
+    let t = screen(80, 24, &mode_state(Threading::Pool, 256), &r);
+    let text = rows(&t);
+    let summary = text
+        .iter()
+        .find(|l| l.contains("pool x256:"))
+        .expect("the pool summary");
+    assert!(
+        text.iter()
+            .any(|l| l.contains("each cell: the busiest of 2 threads")),
+        "{}",
+        text.join("\n")
+    );
+    assert!(summary.contains("min 0 mean"), "{summary}");
+    assert_every_thread_visible(&text, &r, "256 at 80x24");
 }

@@ -181,15 +181,23 @@ impl Threads<'_> {
             let grid_rows = height.saturating_sub(lines.len() + 1 + totals.len()).max(1);
             let loads: Vec<f64> = members.iter().map(|t| t.percent).collect();
             let (min, mean, max) = min_mean_max(&loads);
-            let (per_cell, rows) = grid(&loads, width, grid_rows);
-            let mut summary = format!(
+            let mut grid_at = grid(&loads, width, grid_rows);
+            if grid_at.0 > 1 && grid_rows > 1 {
+                // Shared cells take a line to explain: one grid row less.
+                grid_at = grid(&loads, width, grid_rows - 1);
+            }
+            let (per_cell, rows) = grid_at;
+            let summary = format!(
                 "{prefix} x{}: min {min:.0} mean {mean:.0} max {max:.0} %",
                 loads.len()
             );
-            if per_cell > 1 {
-                summary.push_str(&format!(", {per_cell}/cell max"));
-            }
             lines.push(Line::from(Span::styled(summary, label)));
+            if per_cell > 1 {
+                lines.push(Line::from(Span::styled(
+                    format!("each cell: the busiest of {per_cell} threads"),
+                    label,
+                )));
+            }
             for (start, cells) in rows {
                 let mut spans = vec![Span::styled(start, label)];
                 for (i, (ch, load)) in cells.into_iter().enumerate() {
