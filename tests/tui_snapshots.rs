@@ -610,3 +610,16 @@ fn two_hundred_fifty_six_pool_threads_at_80x24_share_cells_and_say_so() {
     assert!(summary.contains("min 0 mean"), "{summary}");
     assert_every_thread_visible(&text, &r, "256 at 80x24");
 }
+
+#[test]
+fn a_wide_terminal_shows_a_whole_minute_of_sparkline() {
+    let r = report_for(Threading::Pool, 2);
+    let text = rows(&screen(250, 60, &mode_state(Threading::Pool, 2), &r)).join("\n");
+    assert!(text.contains("last 60 s"), "{text}");
+    // The 60 one-second samples of `physics` (never idle), all drawn.
+    let row = text.lines().rfind(|l| l.contains("│physics ")).unwrap();
+    let bars = row.chars().filter(|c| "▁▂▃▄▅▆▇█".contains(*c)).count();
+    assert_eq!(bars, 60, "{row}");
+    let text = rows(&screen(80, 24, &mode_state(Threading::Pool, 2), &r)).join("\n");
+    assert!(text.contains("last 20 s"), "{text}");
+}

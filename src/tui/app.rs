@@ -21,7 +21,7 @@ pub const MIN_HEIGHT: u16 = 22;
 /// The side panel's width, and the most it grows to on wide terminals
 /// (a minute of sparkline: name, figure and 60 bars).
 pub const PANEL_WIDTH: u16 = 44;
-pub const PANEL_MAX: u16 = 83;
+pub const PANEL_MAX: u16 = 84;
 
 /// Everything one frame shows.
 pub struct View<'a> {
@@ -51,7 +51,7 @@ pub fn areas(area: Rect, report: &CpuReport) -> Option<Areas> {
         return None;
     }
     let [main, bar] = Layout::vertical([Constraint::Fill(1), Constraint::Length(1)]).areas(area);
-    let panel = PANEL_WIDTH.max((area.width / 3).min(PANEL_MAX));
+    let panel = PANEL_WIDTH.max((area.width.saturating_add(2) / 3).min(PANEL_MAX));
     let [canvas, side] =
         Layout::horizontal([Constraint::Fill(1), Constraint::Length(panel)]).areas(main);
     let top = readouts_height(side, report);
