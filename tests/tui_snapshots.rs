@@ -623,3 +623,15 @@ fn a_wide_terminal_shows_a_whole_minute_of_sparkline() {
     let text = rows(&screen(80, 24, &mode_state(Threading::Pool, 2), &r)).join("\n");
     assert!(text.contains("last 20 s"), "{text}");
 }
+
+#[test]
+fn no_per_thread_figures_yet_still_draws_chart_and_panel() {
+    let r = CpuReport::default();
+    let mut st = state();
+    for chart in [false, true] {
+        st.chart = chart;
+        let text = rows(&screen(80, 24, &st, &r)).join("\n");
+        assert!(text.contains("no per-thread figures yet"), "{text}");
+        assert!(text.contains("other procs"), "{text}");
+    }
+}

@@ -92,7 +92,8 @@ pub fn compact_height(report: &CpuReport, inner_width: usize) -> u16 {
         1 + grid(&loads, inner_width, usize::MAX).1.len()
     });
     // The totals take one row, two on narrow panels: count two.
-    (singles.len().div_ceil(2) + group_rows + 2 + 2) as u16
+    // An empty report still takes a row to say so.
+    (singles.len().div_ceil(2).max(1) + group_rows + 2 + 2) as u16
 }
 
 impl Threads<'_> {
@@ -167,6 +168,9 @@ impl Threads<'_> {
                 Line::from(spans)
             })
             .collect();
+        if self.report.threads.is_empty() {
+            lines.push(Line::from("(no per-thread figures yet)"));
+        }
         let total = format!(
             "total {:.1} of {} cores",
             self.report.total_percent, self.report.cores
