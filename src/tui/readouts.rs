@@ -189,7 +189,9 @@ impl Readouts<'_> {
             ]),
             pair(
                 "tick",
-                format!("{}/frame", s.tick),
+                // The number first and alone, as in the full form, so a
+                // reader (or a test) takes the tick from the first word.
+                format!("{} step{}", s.tick, if s.tick == 1 { "" } else { "s" }),
                 "count",
                 snap.spheres.len().to_string(),
             ),
