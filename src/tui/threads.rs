@@ -52,11 +52,12 @@ pub fn cell(percent: f64) -> char {
 /// The numbered group (`pool-N`) with the most members, if it has two or
 /// more, sorted by number; and every thread not in it, in report order.
 pub fn split_group(report: &CpuReport) -> (Vec<&ThreadLoad>, Option<(String, Vec<&ThreadLoad>)>) {
-    let numbered = |t: &ThreadLoad| -> Option<(String, u32)> {
+    // `pool-12` -> ("pool", 12); no allocation, as this runs every frame.
+    fn numbered(t: &ThreadLoad) -> Option<(&str, u32)> {
         let (prefix, n) = t.name.rsplit_once('-')?;
-        Some((prefix.to_string(), n.parse().ok()?))
-    };
-    let mut counts: Vec<(String, usize)> = Vec::new();
+        Some((prefix, n.parse().ok()?))
+    }
+    let mut counts: Vec<(&str, usize)> = Vec::new();
     for t in &report.threads {
         if let Some((p, _)) = numbered(t) {
             match counts.iter_mut().find(|c| c.0 == p) {
@@ -69,12 +70,17 @@ pub fn split_group(report: &CpuReport) -> (Vec<&ThreadLoad>, Option<(String, Vec
     let Some((prefix, _)) = best else {
         return (report.threads.iter().collect(), None);
     };
-    let (mut members, singles): (Vec<&ThreadLoad>, Vec<&ThreadLoad>) = report
-        .threads
-        .iter()
-        .partition(|t| numbered(t).is_some_and(|(p, _)| p == prefix));
-    members.sort_by_key(|t| numbered(t).map_or(0, |(_, n)| n));
-    (singles, Some((prefix, members)))
+    let mut members: Vec<(u32, &ThreadLoad)> = Vec::new();
+    let mut singles: Vec<&ThreadLoad> = Vec::new();
+    for t in &report.threads {
+        match numbered(t) {
+            Some((p, n)) if p == prefix => members.push((n, t)),
+            _ => singles.push(t),
+        }
+    }
+    members.sort_by_key(|m| m.0);
+    let members = members.into_iter().map(|m| m.1).collect();
+    (singles, Some((prefix.to_string(), members)))
 }
 
 /// Panel rows (border included) for one row per thread.
