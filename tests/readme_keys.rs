@@ -1,8 +1,8 @@
 //! README.md's "## Keys" table lists exactly the keys the app binds
 //! (`ballpit::tui::keys::TABLE`, which also drives dispatch, the `?`
 //! overlay and the key bar). A row's first cell holds its keys in
-//! backticks ("`p` / `P`", "`q`, `Esc`, `Ctrl-C`"); a cell without
-//! backticks names its keys in words ("arrows").
+//! backticks ("`p`/`P`", "`q`, `Esc`, `Ctrl-C`", "`←`/`→`/`↑`/`↓`"); a
+//! cell without backticks may say "arrows" for the four arrow keys.
 use ballpit::tui::keys::TABLE;
 use std::collections::BTreeSet;
 
@@ -25,7 +25,11 @@ fn readme_keys(readme: &str) -> BTreeSet<String> {
             .trim();
         let quoted: Vec<&str> = cell.split('`').skip(1).step_by(2).collect();
         if quoted.is_empty() {
-            keys.insert(cell.to_string());
+            if cell == "arrows" {
+                keys.extend(["←", "→", "↑", "↓"].map(String::from));
+            } else {
+                keys.insert(cell.to_string());
+            }
         } else {
             keys.extend(quoted.into_iter().map(str::to_string));
         }
@@ -45,11 +49,14 @@ fn the_parser_reads_backticks_slashes_commas_and_words() {
     let md = "# x\n\n## Keys\n\n| key | action |\n|---|---|\n\
               | `q`, `Esc`, `Ctrl-C` | quit |\n| `p` / `P` | pool |\n\
               | `[`/`]` | tick |\n| arrows | camera |\n| `space` | pause |\n\
+              | `←`/`→` | also arrows |\n\
               \n## Next\n| `z` | not a key |\n";
     let got: Vec<String> = readme_keys(md).into_iter().collect();
     assert_eq!(
         got,
-        ["Ctrl-C", "Esc", "P", "[", "]", "arrows", "p", "q", "space"]
+        [
+            "Ctrl-C", "Esc", "P", "[", "]", "p", "q", "space", "←", "↑", "→", "↓"
+        ]
     );
 }
 

@@ -22,14 +22,11 @@ impl Press {
     }
 
     /// The name the README's "## Keys" table uses: `q`, `space`, `Esc`,
-    /// `Ctrl-C`, and `arrows` for the four arrow keys.
+    /// `Ctrl-C`, and `←` `→` `↑` `↓` for the arrow keys.
     pub fn doc_name(self) -> String {
         match self {
-            Press::Char(' ') => "space".into(),
-            Press::Char(c) => c.to_string(),
-            Press::Esc => "Esc".into(),
             Press::Ctrl(c) => format!("Ctrl-{}", c.to_ascii_uppercase()),
-            Press::Left | Press::Right | Press::Up | Press::Down => "arrows".into(),
+            other => other.short(),
         }
     }
 
