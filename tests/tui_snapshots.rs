@@ -67,6 +67,45 @@ fn report() -> CpuReport {
         ],
         total_percent: 99.5,
         cores: 2,
+        others_percent: Some(42.0),
+    }
+}
+
+/// The threads the app has in `mode` with `pool` pool threads, loaded
+/// unevenly, with a minute of history each.
+fn report_for(mode: Threading, pool: usize) -> CpuReport {
+    let mut names: Vec<String> = ["main", "physics", "signals", "input"]
+        .map(String::from)
+        .to_vec();
+    match mode {
+        Threading::Pool => names.extend((0..pool).map(|i| format!("pool-{i}"))),
+        Threading::Split => names.extend(["split-pair".to_string(), "split-wall".to_string()]),
+        _ => {}
+    }
+    // Loads a two-core machine could give: the more threads, the less each.
+    let scale = (8.0 / names.len() as f64).min(1.0);
+    let threads: Vec<ThreadLoad> = names
+        .into_iter()
+        .enumerate()
+        .map(|(i, name)| {
+            let base = ((i * 37) % 101) as f64;
+            let history: Vec<f64> = (0..60)
+                .map(|s| ((base + (s * (i + 3)) as f64 % 40.0) * scale).min(100.0))
+                .collect();
+            ThreadLoad {
+                tid: 100 + i as i32,
+                name,
+                percent: *history.last().unwrap(),
+                cpu_seconds: 1.0,
+                history,
+            }
+        })
+        .collect();
+    CpuReport {
+        total_percent: threads.iter().map(|t| t.percent).sum(),
+        threads,
+        cores: 2,
+        others_percent: Some(37.5),
     }
 }
 
@@ -82,7 +121,7 @@ fn render(w: u16, h: u16, f: impl FnOnce(&mut ratatui::Frame)) -> Terminal<TestB
 
 fn readouts(st: &AppState, snap: &Snapshot, palette: Palette) -> Terminal<TestBackend> {
     let stats = stats();
-    render(44, 18, |f| {
+    render(44, ballpit::tui::readouts::HEIGHT, |f| {
         f.render_widget(
             Readouts {
                 state: st,
@@ -144,7 +183,7 @@ fn readouts_panel_paused_in_pool_mode() {
     insta::assert_snapshot!(t.backend());
     // Without colour, the pause cue is reverse video.
     let buf = t.backend().buffer();
-    let y = (0..18)
+    let y = (0..ballpit::tui::readouts::HEIGHT)
         .find(|&y| buf[(2, y)].symbol() == "P")
         .expect("the PAUSED line");
     assert!(
@@ -157,7 +196,7 @@ fn readouts_panel_paused_in_pool_mode() {
 #[test]
 fn threads_panel() {
     let r = report();
-    let t = render(44, 8, |f| {
+    let t = render(44, 9, |f| {
         f.render_widget(
             Threads {
                 report: &r,
@@ -180,7 +219,7 @@ fn help_bar_and_overlay() {
         )
     });
     insta::assert_snapshot!("help_bar", t.backend());
-    let t = render(70, 22, |f| {
+    let t = render(70, 20, |f| {
         f.render_widget(
             HelpOverlay {
                 palette: Palette::C16,
@@ -260,4 +299,339 @@ fn whole_screen_and_the_too_small_message() {
     insta::assert_snapshot!("whole_screen", t.backend());
     let t = render(60, 12, |f| app::draw(f, &mut raster, &view));
     insta::assert_snapshot!("too_small", t.backend());
+}
+
+/// The screen's rows as text.
+fn rows(t: &Terminal<TestBackend>) -> Vec<String> {
+    let buf = t.backend().buffer();
+    (0..buf.area.height)
+        .map(|y| (0..buf.area.width).map(|x| buf[(x, y)].symbol()).collect())
+        .collect()
+}
+
+const CELLS: &str = "·▁▂▃▄▅▆▇█";
+
+/// Every thread of `r` is on screen: its name on a row of its own, or, for
+/// the numbered group in the compact view, a cell each (or a cell per
+/// `k` threads when the summary says `k/cell`); and the total and others.
+fn assert_every_thread_visible(text: &[String], r: &CpuReport, what: &str) {
+    let all = text.join("\n");
+    assert!(all.contains("total"), "{what}: no total\n{all}");
+    assert!(all.contains("other procs"), "{what}: no other procs\n{all}");
+    let (singles, group) = ballpit::tui::threads::split_group(r);
+    let summary = group.as_ref().and_then(|(prefix, members)| {
+        let head = format!("{prefix} x{}:", members.len());
+        text.iter().position(|l| l.contains(&head))
+    });
+    match (group, summary) {
+        (Some((_, members)), Some(at)) => {
+            for t in &singles {
+                let name: String = t.name.chars().take(11).collect();
+                assert!(all.contains(&name), "{what}: {name} missing\n{all}");
+            }
+            // "each cell: the busiest of K threads" when cells are shared.
+            let per_cell: usize = text[at + 1]
+                .split("busiest of ")
+                .nth(1)
+                .map_or(1, |k| k.split(' ').next().unwrap().parse().unwrap());
+            let cells: usize = text[at + 1..]
+                .iter()
+                .take_while(|l| !l.contains("total"))
+                .map(|l| l.chars().filter(|c| CELLS.contains(*c)).count())
+                .sum();
+            assert_eq!(
+                cells,
+                members.len().div_ceil(per_cell),
+                "{what}: cells for {} threads at {per_cell}/cell\n{all}",
+                members.len()
+            );
+        }
+        _ => {
+            for t in &r.threads {
+                let name: String = t.name.chars().take(11).collect();
+                assert!(
+                    text.iter().any(|l| l.contains(&name)),
+                    "{what}: {name} missing\n{all}"
+                );
+            }
+        }
+    }
+}
+
+fn screen(w: u16, h: u16, st: &AppState, r: &CpuReport) -> Terminal<TestBackend> {
+    let (snap, stats) = (snapshot(), stats());
+    let view = View {
+        state: st,
+        snap: &snap,
+        stats: &stats,
+        report: r,
+        palette: Palette::C16,
+        aspect: 2.0,
+    };
+    let mut raster = Raster::new();
+    render(w, h, |f| app::draw(f, &mut raster, &view))
+}
+
+fn mode_state(mode: Threading, pool: usize) -> AppState {
+    let mut st = state();
+    st.threading = mode;
+    st.threads = pool;
+    st
+}
+
+#[test]
+fn every_thread_and_the_total_at_80x24_and_120x40() {
+    let cases = [
+        ("pool_2", Threading::Pool, 2),
+        ("split", Threading::Split, 2),
+        ("pool_64", Threading::Pool, 64),
+    ];
+    for (name, mode, pool) in cases {
+        let r = report_for(mode, pool);
+        let st = mode_state(mode, pool);
+        for (w, h) in [(80, 24), (120, 40)] {
+            let t = screen(w, h, &st, &r);
+            let what = format!("{name}_{w}x{h}");
+            assert_every_thread_visible(&rows(&t), &r, &what);
+            insta::assert_snapshot!(what, t.backend());
+        }
+    }
+}
+
+#[test]
+fn sixty_four_pool_threads_at_80x24_are_a_grid_with_min_mean_max() {
+    let r = report_for(Threading::Pool, 64);
+    let t = screen(80, 24, &mode_state(Threading::Pool, 64), &r);
+    let text = rows(&t).join("\n");
+    let loads: Vec<f64> = r
+        .threads
+        .iter()
+        .filter(|t| t.name.starts_with("pool-"))
+        .map(|t| t.percent)
+        .collect();
+    let min = loads.iter().copied().fold(f64::INFINITY, f64::min);
+    let max = loads.iter().copied().fold(0.0, f64::max);
+    let mean = loads.iter().sum::<f64>() / 64.0;
+    let want = format!("pool x64: min {min:.0} mean {mean:.0} max {max:.0} %");
+    assert!(text.contains(&want), "{want}\n{text}");
+    // A cell a thread: no "/cell" in the summary.
+    assert!(!text.contains("/cell"), "{text}");
+}
+
+#[test]
+fn any_size_from_the_minimum_and_any_thread_count_shows_every_thread() {
+    use ballpit::tui::app::{MIN_HEIGHT, MIN_WIDTH};
+    for pool in [1, 3, 9, 33, 100, 256] {
+        let r = report_for(Threading::Pool, pool);
+        let mut st = mode_state(Threading::Pool, pool);
+        for w in (MIN_WIDTH..=250).step_by(29).chain([80, 250]) {
+            for h in (MIN_HEIGHT..=80).step_by(9).chain([24, 80]) {
+                st.chart = (w + h) % 2 == 0;
+                let t = screen(w, h, &st, &r);
+                assert_every_thread_visible(&rows(&t), &r, &format!("{pool} at {w}x{h}"));
+            }
+        }
+    }
+}
+
+#[test]
+fn below_the_minimum_a_message_and_no_panic_at_0x0_or_1x1() {
+    use ballpit::tui::app::{MIN_HEIGHT, MIN_WIDTH};
+    let r = report_for(Threading::Pool, 2);
+    let st = state();
+    for (w, h) in [
+        (0, 0),
+        (1, 1),
+        (0, 5),
+        (5, 0),
+        (MIN_WIDTH - 1, 40),
+        (100, MIN_HEIGHT - 1),
+    ] {
+        let t = screen(w, h, &st, &r);
+        if w >= 30 {
+            let text = rows(&t).join("\n");
+            assert!(
+                text.contains(&format!("needs at least {MIN_WIDTH}x{MIN_HEIGHT}")),
+                "{text}"
+            );
+            assert!(text.contains(&format!("is {w}x{h}")), "{text}");
+        }
+    }
+}
+
+#[test]
+fn help_overlay_fits_at_80x24() {
+    let mut st = state();
+    st.help = true;
+    let r = report_for(Threading::Pool, 2);
+    let t = screen(80, 24, &st, &r);
+    insta::assert_snapshot!("help_overlay_80x24", t.backend());
+    let text = rows(&t).join("\n");
+    for b in ballpit::tui::keys::TABLE {
+        assert!(text.contains(b.help), "{} missing\n{text}", b.help);
+    }
+    assert!(text.contains("? or Esc closes this help"), "{text}");
+}
+
+#[test]
+fn the_key_bar_at_80_columns_keeps_the_keys_that_matter_most() {
+    let t = screen(80, 24, &state(), &report_for(Threading::Off, 0));
+    let bar = rows(&t).pop().unwrap();
+    for k in [
+        "? help", "q quit", "t thread", "d mode", "c chart", "p/P pool",
+    ] {
+        assert!(bar.contains(k), "{k} missing: {bar}");
+    }
+}
+
+#[test]
+fn chart_view_has_a_line_per_thread_and_groups_many() {
+    let mut st = mode_state(Threading::Pool, 2);
+    st.chart = true;
+    let r = report_for(Threading::Pool, 2);
+    let t = screen(120, 40, &st, &r);
+    insta::assert_snapshot!("chart_120x40_pool_2", t.backend());
+    let text = rows(&t).join("\n");
+    assert!(text.contains("CPU per thread, last 60 s"), "{text}");
+    for name in ["main", "physics", "pool-0", "pool-1"] {
+        assert!(text.contains(name), "{name}\n{text}");
+    }
+    // Lines are drawn in braille, in one colour per thread.
+    let buf = t.backend().buffer();
+    let braille_colours: std::collections::BTreeSet<String> = buf
+        .content()
+        .iter()
+        .filter(|c| {
+            c.symbol()
+                .chars()
+                .any(|ch| ('\u{2801}'..='\u{28ff}').contains(&ch))
+        })
+        .map(|c| format!("{:?}", c.fg))
+        .collect();
+    assert!(braille_colours.len() >= 4, "{braille_colours:?}");
+    assert!(text.contains("100 %") && text.contains("-59 s"), "{text}");
+
+    let mut st = mode_state(Threading::Pool, 64);
+    st.chart = true;
+    let r = report_for(Threading::Pool, 64);
+    let t = screen(80, 24, &st, &r);
+    insta::assert_snapshot!("chart_80x24_pool_64", t.backend());
+    let text = rows(&t).join("\n");
+    assert!(text.contains("pool-* mean of 64"), "{text}");
+    assert!(text.contains("pool-* max of 64"), "{text}");
+}
+
+#[test]
+fn readouts_show_the_radius_in_force_not_the_one_asked_for() {
+    let mut st = state();
+    // Asked for 0.5; the snapshot's largest sphere is 0.15.
+    st.radius = 0.5;
+    let t = readouts(&st, &snapshot(), Palette::C16);
+    let text = rows(&t).join("\n");
+    assert!(text.contains("radius     0.15000"), "{text}");
+    assert!(!text.contains("0.50000"), "{text}");
+}
+
+#[test]
+fn paused_and_frozen_say_so_instead_of_a_frame_rate() {
+    let mut st = state();
+    st.paused = true;
+    let text = rows(&readouts(&st, &snapshot(), Palette::C16)).join("\n");
+    assert!(text.contains("fps        paused"), "{text}");
+    assert!(!text.contains("29.9"), "{text}");
+    assert!(text.contains("physics    idle"), "{text}");
+    let mut st = state();
+    st.tick = 0;
+    let text = rows(&readouts(&st, &snapshot(), Palette::C16)).join("\n");
+    assert!(text.contains("fps        frozen (tick 0)"), "{text}");
+    // The compact form too.
+    let t = screen(80, 24, &st, &report_for(Threading::Pool, 2));
+    let text = rows(&t).join("\n");
+    assert!(text.contains("fps     frozen"), "{text}");
+}
+
+#[test]
+fn a_long_notice_wraps_instead_of_being_cut() {
+    let mut st = state();
+    let notice = "count limit: no free space for more spheres (1234 of 2000)";
+    st.notice = Some(notice.into());
+    let r = report_for(Threading::Pool, 2);
+    let small = ballpit::tui::app::areas(ratatui::layout::Rect::new(0, 0, 80, 24), &r).unwrap();
+    for (t, x0) in [
+        (readouts(&st, &snapshot(), Palette::C16), 0),
+        (screen(80, 24, &st, &r), small.readouts.x),
+    ] {
+        let text: String = rows(&t)
+            .iter()
+            .map(|l| l.chars().skip(usize::from(x0)).collect::<String>())
+            .map(|l| l.replace('│', " "))
+            .collect::<Vec<_>>()
+            .join(" ");
+        let words: String = text.split_whitespace().collect::<Vec<_>>().join(" ");
+        assert!(words.contains(notice), "{words}");
+    }
+}
+
+#[test]
+fn others_line_shows_what_other_processes_take() {
+    let r = report_for(Threading::Pool, 2);
+    let t = screen(120, 40, &mode_state(Threading::Pool, 2), &r);
+    let text = rows(&t).join("\n");
+    assert!(
+        text.contains("other procs    37.5  rest of the machine"),
+        "{text}"
+    );
+    let mut r = r;
+    r.others_percent = None;
+    let text = rows(&screen(80, 24, &mode_state(Threading::Pool, 2), &r)).join("\n");
+    // Not known yet: a dash, not a made-up zero.
+    assert!(
+        text.lines()
+            .any(|l| l.contains("other procs") && l.contains(" -  ")),
+        "{text}"
+    );
+}
+
+#[test]
+fn two_hundred_fifty_six_pool_threads_at_80x24_share_cells_and_say_so() {
+    let r = report_for(Threading::Pool, 256);
+    let t = screen(80, 24, &mode_state(Threading::Pool, 256), &r);
+    let text = rows(&t);
+    let summary = text
+        .iter()
+        .find(|l| l.contains("pool x256:"))
+        .expect("the pool summary");
+    assert!(
+        text.iter()
+            .any(|l| l.contains("each cell: the busiest of 2 threads")),
+        "{}",
+        text.join("\n")
+    );
+    assert!(summary.contains("min 0 mean"), "{summary}");
+    assert_every_thread_visible(&text, &r, "256 at 80x24");
+}
+
+#[test]
+fn a_wide_terminal_shows_a_whole_minute_of_sparkline() {
+    let r = report_for(Threading::Pool, 2);
+    let text = rows(&screen(250, 60, &mode_state(Threading::Pool, 2), &r)).join("\n");
+    assert!(text.contains("last 60 s"), "{text}");
+    // The 60 one-second samples of `physics` (never idle), all drawn.
+    let row = text.lines().rfind(|l| l.contains("│physics ")).unwrap();
+    let bars = row.chars().filter(|c| "▁▂▃▄▅▆▇█".contains(*c)).count();
+    assert_eq!(bars, 60, "{row}");
+    let text = rows(&screen(80, 24, &mode_state(Threading::Pool, 2), &r)).join("\n");
+    assert!(text.contains("last 20 s"), "{text}");
+}
+
+#[test]
+fn no_per_thread_figures_yet_still_draws_chart_and_panel() {
+    let r = CpuReport::default();
+    let mut st = state();
+    for chart in [false, true] {
+        st.chart = chart;
+        let text = rows(&screen(80, 24, &st, &r)).join("\n");
+        assert!(text.contains("no per-thread figures yet"), "{text}");
+        assert!(text.contains("other procs"), "{text}");
+    }
 }

@@ -270,3 +270,50 @@ fn sync_takes_the_real_count_radius_and_the_engine_notice() {
     a.sync(&snap, true);
     assert!(a.notice.is_none());
 }
+
+#[test]
+fn c_swaps_the_canvas_for_the_chart_and_back() {
+    let mut a = app();
+    assert!(!a.chart);
+    assert!(key(&mut a, KeyCode::Char('c')).is_empty());
+    assert!(a.chart);
+    // Keys for the hidden canvas still act, and say why nothing shows.
+    let yaw = a.camera.yaw;
+    key(&mut a, KeyCode::Left);
+    assert!(a.camera.yaw < yaw);
+    assert!(a.notice.as_deref().unwrap().contains("chart"));
+    key(&mut a, KeyCode::Char('c'));
+    assert!(!a.chart);
+    key(&mut a, KeyCode::Left);
+    assert!(a.notice.is_none());
+}
+
+#[test]
+fn p_while_not_in_pool_mode_keeps_the_size_and_says_where_it_applies() {
+    let mut a = app();
+    assert_eq!(a.threading, Threading::Off);
+    assert_eq!(key(&mut a, KeyCode::Char('P')), [Command::SetThreads(5)]);
+    assert_eq!(a.threads, 5);
+    let n = a.notice.clone().unwrap();
+    assert!(
+        n.contains("pool threads 5") && n.contains("pool mode") && n.contains("off"),
+        "{n}"
+    );
+    // In pool mode the key just acts.
+    a.threading = Threading::Pool;
+    assert_eq!(key(&mut a, KeyCode::Char('p')), [Command::SetThreads(4)]);
+    assert!(a.notice.is_none());
+    // In pool mode with exact, the size has no effect either.
+    a.model = ModelKind::Exact;
+    key(&mut a, KeyCode::Char('P'));
+    assert!(a.notice.as_deref().unwrap().contains("exact"));
+}
+
+#[test]
+fn tick_keys_while_paused_say_the_tick_runs_on_resume() {
+    let mut a = app();
+    key(&mut a, KeyCode::Char(' '));
+    key(&mut a, KeyCode::Char(']'));
+    assert_eq!(a.tick, 2);
+    assert!(a.notice.as_deref().unwrap().contains("resumed"));
+}

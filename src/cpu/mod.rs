@@ -1,11 +1,15 @@
 //! Per-thread CPU load of this process, read from procfs on Linux
 //! (`/proc/self/task/*/schedstat`, nanosecond run time, falling back to the
-//! clock ticks of `stat`), by thread name from `comm`. Elsewhere the report
-//! holds only the core count.
+//! clock ticks of `stat`), by thread name from `comm`, and what other
+//! processes take (`machine`). Elsewhere the report holds only the core count.
+pub mod history;
+pub mod machine;
 mod task;
 
 pub use task::{current_tid, thread_cpu_seconds_of};
 
+use history::History;
+use machine::Others;
 use std::collections::{HashMap, VecDeque};
 use std::time::{Duration, Instant};
 
@@ -18,7 +22,8 @@ pub struct ThreadLoad {
     pub percent: f64,
     /// Total CPU seconds since the thread started.
     pub cpu_seconds: f64,
-    /// Recent `percent` samples, oldest first, for sparklines.
+    /// `percent` once a second over the last minute (`history::LEN` at
+    /// most), oldest first, for the sparklines and the chart.
     pub history: Vec<f64>,
 }
 
@@ -28,20 +33,19 @@ pub struct CpuReport {
     pub threads: Vec<ThreadLoad>,
     pub total_percent: f64,
     pub cores: usize,
+    /// What other processes took, percent of one core (None until two
+    /// readings, or off Linux).
+    pub others_percent: Option<f64>,
 }
 
 /// How long the load is averaged over.
 pub const WINDOW: Duration = Duration::from_secs(1);
-/// One history point per this much time...
-pub const HISTORY_STEP: Duration = Duration::from_millis(500);
-/// ...and this many points: a minute of sparkline.
-pub const HISTORY_LEN: usize = 120;
 
 struct Track {
     name: String,
     /// (when, CPU seconds) samples covering at least the window.
     samples: VecDeque<(Instant, f64)>,
-    history: VecDeque<f64>,
+    history: History,
     seen: bool,
 }
 
@@ -50,7 +54,9 @@ struct Track {
 pub struct Sampler {
     report: CpuReport,
     tracks: HashMap<i32, Track>,
-    last_history: Option<Instant>,
+    /// Shared by every thread's history, so their seconds line up.
+    origin: Instant,
+    others: Others,
     cores: usize,
 }
 
@@ -69,7 +75,8 @@ impl Sampler {
                 ..CpuReport::default()
             },
             tracks: HashMap::new(),
-            last_history: None,
+            origin: Instant::now(),
+            others: Others::default(),
             cores,
         }
     }
@@ -80,11 +87,12 @@ impl Sampler {
         for t in self.tracks.values_mut() {
             t.seen = false;
         }
+        let origin = self.origin;
         for (tid, name, secs) in task::read_threads() {
             let t = self.tracks.entry(tid).or_insert_with(|| Track {
                 name: String::new(),
                 samples: VecDeque::new(),
-                history: VecDeque::new(),
+                history: History::new(origin),
                 seen: false,
             });
             t.name = name;
@@ -96,12 +104,6 @@ impl Sampler {
             }
         }
         self.tracks.retain(|_, t| t.seen);
-        let push_history = self
-            .last_history
-            .is_none_or(|h| now.duration_since(h) >= HISTORY_STEP);
-        if push_history {
-            self.last_history = Some(now);
-        }
         let mut threads: Vec<ThreadLoad> = self
             .tracks
             .iter_mut()
@@ -114,18 +116,13 @@ impl Sampler {
                 } else {
                     0.0
                 };
-                if push_history {
-                    t.history.push_back(percent);
-                    while t.history.len() > HISTORY_LEN {
-                        t.history.pop_front();
-                    }
-                }
+                t.history.push(now, percent);
                 ThreadLoad {
                     tid,
                     name: t.name.clone(),
                     percent,
                     cpu_seconds: c1,
-                    history: t.history.iter().copied().collect(),
+                    history: t.history.values(),
                 }
             })
             .collect();
@@ -134,6 +131,7 @@ impl Sampler {
             total_percent: threads.iter().map(|t| t.percent).sum(),
             threads,
             cores: self.cores,
+            others_percent: self.others.sample(),
         };
         &self.report
     }

@@ -42,15 +42,9 @@ pub fn thread_cpu_seconds_of(tid: i32) -> Option<f64> {
     stat_cpu_seconds(&stat)
 }
 
-/// utime + stime out of a `stat` line; the name in parentheses may itself
-/// hold spaces and parentheses, so fields are counted after the last `)`.
+/// utime + stime out of a `stat` line, in seconds.
 pub fn stat_cpu_seconds(stat: &str) -> Option<f64> {
-    let rest = &stat[stat.rfind(')')? + 1..];
-    let mut fields = rest.split_whitespace();
-    // After ')': state is field 3; utime and stime are fields 14 and 15.
-    let utime: u64 = fields.nth(11)?.parse().ok()?;
-    let stime: u64 = fields.next()?.parse().ok()?;
-    Some((utime + stime) as f64 / TICKS_PER_SECOND)
+    Some(super::machine::stat_ticks(stat)? as f64 / TICKS_PER_SECOND)
 }
 
 /// The calling thread's id (Linux), from `/proc/thread-self`.

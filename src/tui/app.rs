@@ -1,11 +1,14 @@
-//! One screen: where each part goes, and the message when the terminal is
-//! too small for them.
+//! One screen: where each part goes at this size, and the message when the
+//! terminal is too small for them. At 80x24 the readouts go compact so
+//! every thread keeps a row; with more threads than rows the thread panel
+//! goes compact (a grid) and the readouts may stay whole.
 use super::canvas::{Raster, Scene};
+use super::chart::CpuChart;
 use super::help::{HelpBar, HelpOverlay};
 use super::readouts::{self, Readouts, Stats};
 use super::state::AppState;
 use super::theme::Palette;
-use super::threads::Threads;
+use super::threads::{self, Threads};
 use crate::cpu::CpuReport;
 use crate::engine::Snapshot;
 use ratatui::Frame;
@@ -15,7 +18,10 @@ use ratatui::widgets::{Paragraph, Wrap};
 
 pub const MIN_WIDTH: u16 = 72;
 pub const MIN_HEIGHT: u16 = 22;
+/// The side panel's width, and the most it grows to on wide terminals
+/// (a minute of sparkline: name, figure and 60 bars).
 pub const PANEL_WIDTH: u16 = 44;
+pub const PANEL_MAX: u16 = 84;
 
 /// Everything one frame shows.
 pub struct View<'a> {
@@ -28,36 +34,82 @@ pub struct View<'a> {
     pub aspect: f64,
 }
 
+/// Where the parts go.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Areas {
+    pub canvas: Rect,
+    pub readouts: Rect,
+    pub threads: Rect,
+    pub bar: Rect,
+    /// Canvas and panel: where the help overlay is centred.
+    pub main: Rect,
+}
+
+/// The layout for `area`, or None when it is below the minimum.
+pub fn areas(area: Rect, report: &CpuReport) -> Option<Areas> {
+    if area.width < MIN_WIDTH || area.height < MIN_HEIGHT {
+        return None;
+    }
+    let [main, bar] = Layout::vertical([Constraint::Fill(1), Constraint::Length(1)]).areas(area);
+    let panel = PANEL_WIDTH.max((area.width.saturating_add(2) / 3).min(PANEL_MAX));
+    let [canvas, side] =
+        Layout::horizontal([Constraint::Fill(1), Constraint::Length(panel)]).areas(main);
+    let top = readouts_height(side, report);
+    let [readouts, threads] =
+        Layout::vertical([Constraint::Length(top), Constraint::Fill(1)]).areas(side);
+    Some(Areas {
+        canvas,
+        readouts,
+        threads,
+        bar,
+        main,
+    })
+}
+
+/// Whole readouts when the threads still fit beside them (a row each, or
+/// a grid with a cell each), else compact ones.
+fn readouts_height(side: Rect, report: &CpuReport) -> u16 {
+    let inner_w = usize::from(side.width.saturating_sub(2));
+    let threads = threads::full_height(report).min(threads::compact_height(report, inner_w));
+    if side.height >= readouts::HEIGHT + threads {
+        readouts::HEIGHT
+    } else {
+        readouts::COMPACT_HEIGHT
+    }
+}
+
 pub fn draw(frame: &mut Frame, raster: &mut Raster, v: &View) {
     let area = frame.area();
-    if area.width < MIN_WIDTH || area.height < MIN_HEIGHT {
+    let Some(a) = areas(area, v.report) else {
         let msg = vec![
-            Line::from("ballpit needs a bigger terminal:"),
-            Line::from(format!(
-                "at least {MIN_WIDTH}x{MIN_HEIGHT}, this one is {}x{}.",
-                area.width, area.height
-            )),
+            Line::from(format!("ballpit needs at least {MIN_WIDTH}x{MIN_HEIGHT};")),
+            Line::from(format!("this terminal is {}x{}.", area.width, area.height)),
             Line::from("q quits."),
         ];
         let h = (msg.len() as u16).min(area.height);
         let r = Rect::new(area.x, area.y + (area.height - h) / 2, area.width, h);
         frame.render_widget(Paragraph::new(msg).centered().wrap(Wrap { trim: true }), r);
         return;
-    }
-    let [main, bar] = Layout::vertical([Constraint::Fill(1), Constraint::Length(1)]).areas(area);
-    let [canvas, side] =
-        Layout::horizontal([Constraint::Fill(1), Constraint::Length(PANEL_WIDTH)]).areas(main);
-    let [top, bottom] =
-        Layout::vertical([Constraint::Length(readouts::HEIGHT), Constraint::Fill(1)]).areas(side);
-    let scene = Scene {
-        box_size: v.snap.size,
-        camera: v.state.camera,
-        style: v.state.style,
-        light: v.state.light,
-        palette: v.palette,
-        aspect: v.aspect,
     };
-    raster.draw(&v.snap.spheres, &scene, canvas, frame.buffer_mut());
+    if v.state.chart {
+        frame.render_widget(
+            CpuChart {
+                report: v.report,
+                palette: v.palette,
+            },
+            a.canvas,
+        );
+    } else {
+        let scene = Scene {
+            box_size: v.snap.size,
+            camera: v.state.camera,
+            style: v.state.style,
+            light: v.state.light,
+            palette: v.palette,
+            aspect: v.aspect,
+        };
+        raster.draw(&v.snap.spheres, &scene, a.canvas, frame.buffer_mut());
+    }
     frame.render_widget(
         Readouts {
             state: v.state,
@@ -65,17 +117,17 @@ pub fn draw(frame: &mut Frame, raster: &mut Raster, v: &View) {
             stats: v.stats,
             palette: v.palette,
         },
-        top,
+        a.readouts,
     );
     frame.render_widget(
         Threads {
             report: v.report,
             palette: v.palette,
         },
-        bottom,
+        a.threads,
     );
-    frame.render_widget(HelpBar { palette: v.palette }, bar);
+    frame.render_widget(HelpBar { palette: v.palette }, a.bar);
     if v.state.help {
-        frame.render_widget(HelpOverlay { palette: v.palette }, canvas);
+        frame.render_widget(HelpOverlay { palette: v.palette }, a.main);
     }
 }

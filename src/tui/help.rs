@@ -1,11 +1,13 @@
-//! The help bar (always there) and the `?` overlay (every key, explained).
-use super::input::KEYS;
+//! The key bar (always there) and the `?` overlay (every key, explained),
+//! both read from `keys::TABLE`.
+use super::keys::{self, TABLE};
 use super::theme::Palette;
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Clear, Paragraph, Widget};
 
+/// The keys that matter most at this width (`keys::bar_entries`).
 pub struct HelpBar {
     pub palette: Palette,
 }
@@ -13,7 +15,7 @@ pub struct HelpBar {
 impl Widget for HelpBar {
     fn render(self, area: Rect, buf: &mut Buffer) {
         let mut spans = Vec::new();
-        for (key, label) in KEYS.iter().filter_map(|k| k.1) {
+        for (key, label) in keys::bar_entries(usize::from(area.width)) {
             spans.push(Span::styled(key, self.palette.key()));
             spans.push(Span::raw(format!(" {label} ")));
         }
@@ -25,15 +27,19 @@ pub struct HelpOverlay {
     pub palette: Palette,
 }
 
+/// Columns of the key column, its leading space included.
+const KEY_W: usize = 10;
+
 impl HelpOverlay {
-    /// Rows are " key       description": 11 columns, the text, one spare.
+    /// Rows are " key      description ": the key column, the text, one
+    /// spare; the border carries the title and how to close it.
     pub fn size() -> (u16, u16) {
-        let w = KEYS
+        let w = TABLE
             .iter()
-            .map(|(_, _, d)| 12 + d.len())
+            .map(|b| KEY_W + 2 + b.help.chars().count())
             .max()
             .unwrap_or(40);
-        (w as u16 + 2, KEYS.len() as u16 + 4)
+        (w as u16 + 2, TABLE.len() as u16 + 2)
     }
 }
 
@@ -49,19 +55,24 @@ impl Widget for HelpOverlay {
             h,
         );
         Clear.render(r, buf);
-        let mut lines: Vec<Line> = KEYS
+        let lines: Vec<Line> = TABLE
             .iter()
-            .map(|(k, _, d)| {
+            .map(|b| {
                 Line::from(vec![
-                    Span::styled(format!(" {k:<9}"), self.palette.label()),
-                    Span::raw(format!(" {d}")),
+                    Span::styled(
+                        format!(" {:<w$}", b.keys(), w = KEY_W - 1),
+                        self.palette.label(),
+                    ),
+                    Span::raw(format!(" {}", b.help)),
                 ])
             })
             .collect();
-        lines.push(Line::from(""));
-        lines.push(Line::from(" ? or Esc closes this help"));
         Paragraph::new(lines)
-            .block(Block::bordered().title(" keys "))
+            .block(
+                Block::bordered()
+                    .title(" keys ")
+                    .title_bottom(" ? or Esc closes this help "),
+            )
             .render(r, buf);
     }
 }

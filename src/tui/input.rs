@@ -1,5 +1,6 @@
 //! Keys to actions (docs/design.md, Keys). Kept apart from the state so the state
 //! can be tested without a terminal.
+use super::keys::{self, Press};
 use crossterm::event::{KeyCode, KeyEvent, KeyEventKind, KeyModifiers};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -29,91 +30,34 @@ pub enum Action {
     Help,
     SlowerFps,
     FasterFps,
+    /// Swap the canvas for the chart of per-thread CPU, and back.
+    Chart,
 }
 
-/// The key a press means, if any (releases and repeats of modifiers are ignored).
+/// The key a press means, if any (releases are ignored). The keys are in
+/// `keys::TABLE`, the one place that lists them.
 pub fn action(key: KeyEvent) -> Option<Action> {
     if key.kind == KeyEventKind::Release {
         return None;
     }
-    if key.modifiers.contains(KeyModifiers::CONTROL) {
-        return match key.code {
-            KeyCode::Char('c') | KeyCode::Char('C') => Some(Action::Quit),
-            _ => None,
-        };
-    }
-    Some(match key.code {
-        KeyCode::Char('q') => Action::Quit,
-        KeyCode::Esc => Action::Escape,
-        KeyCode::Char('t') => Action::ToggleThreading,
-        KeyCode::Char('d') => Action::CycleThreadedMode,
-        KeyCode::Char('p') => Action::FewerThreads,
-        KeyCode::Char('P') => Action::MoreThreads,
-        KeyCode::Char('[') => Action::TickDown,
-        KeyCode::Char(']') => Action::TickUp,
-        KeyCode::Char(' ') => Action::Pause,
-        KeyCode::Char('n') => Action::HalveCount,
-        KeyCode::Char('N') => Action::DoubleCount,
-        KeyCode::Char('r') => Action::Smaller,
-        KeyCode::Char('R') => Action::Bigger,
-        KeyCode::Char('m') => Action::CycleModel,
-        KeyCode::Left => Action::Left,
-        KeyCode::Right => Action::Right,
-        KeyCode::Up => Action::Up,
-        KeyCode::Down => Action::Down,
-        KeyCode::Char('v') => Action::CycleStyle,
-        KeyCode::Char('l') => Action::MoveLight,
-        KeyCode::Char('0') => Action::Reset,
-        KeyCode::Char('?') => Action::Help,
-        KeyCode::Char('f') => Action::SlowerFps,
-        KeyCode::Char('F') => Action::FasterFps,
-        _ => return None,
-    })
+    let press = if key.modifiers.contains(KeyModifiers::CONTROL) {
+        match key.code {
+            KeyCode::Char(c) => Press::Ctrl(c.to_ascii_lowercase()),
+            _ => return None,
+        }
+    } else {
+        match key.code {
+            KeyCode::Char(c) => Press::Char(c),
+            KeyCode::Esc => Press::Esc,
+            KeyCode::Left => Press::Left,
+            KeyCode::Right => Press::Right,
+            KeyCode::Up => Press::Up,
+            KeyCode::Down => Press::Down,
+            _ => return None,
+        }
+    };
+    keys::lookup(press)
 }
-
-/// Every key with what it does: (keys, help-bar key and label, description
-/// for the `?` overlay). The bar leaves out what doesn't fit in 120 columns;
-/// `?` comes first so it is always there.
-/// Key and label in the help bar, if it has room.
-pub type BarEntry = Option<(&'static str, &'static str)>;
-
-pub const KEYS: &[(&str, BarEntry, &str)] = &[
-    ("?", Some(("?", "help")), "this help"),
-    ("q Esc ^C", Some(("q", "quit")), "quit"),
-    (
-        "t",
-        Some(("t", "thread")),
-        "threading on/off (off <-> last threaded mode)",
-    ),
-    (
-        "d",
-        Some(("d", "mode")),
-        "cycle threaded mode: worker -> pool -> split",
-    ),
-    ("p/P", Some(("p/P", "pool")), "pool threads - / +"),
-    (
-        "[/]",
-        Some(("[/]", "tick")),
-        "physics tick - / + (0 freezes)",
-    ),
-    ("space", Some(("spc", "pause")), "pause / resume"),
-    ("n/N", Some(("n/N", "count")), "sphere count /2 / x2"),
-    (
-        "r/R",
-        Some(("r/R", "size")),
-        "sphere radius smaller / bigger",
-    ),
-    ("m", Some(("m", "model")), "cycle collision model"),
-    ("arrows", Some(("←→↑↓", "camera")), "rotate the camera"),
-    (
-        "v",
-        Some(("v", "style")),
-        "cycle drawing style (braille / shaded blocks)",
-    ),
-    ("l", Some(("l", "light")), "move the light (shaded style)"),
-    ("0", Some(("0", "reset")), "reset the scene"),
-    ("f/F", None, "frame rate - / +"),
-];
 
 #[cfg(test)]
 mod tests {
@@ -150,12 +94,18 @@ mod tests {
             (KeyCode::Char('?'), Action::Help),
             (KeyCode::Char('f'), Action::SlowerFps),
             (KeyCode::Char('F'), Action::FasterFps),
+            (KeyCode::Char('c'), Action::Chart),
         ];
         for (code, want) in table {
             assert_eq!(action(press(code)), Some(want), "{code:?}");
         }
         let ctrl_c = KeyEvent::new(KeyCode::Char('c'), KeyModifiers::CONTROL);
         assert_eq!(action(ctrl_c), Some(Action::Quit));
+        let ctrl_shift_c = KeyEvent::new(
+            KeyCode::Char('C'),
+            KeyModifiers::CONTROL | KeyModifiers::SHIFT,
+        );
+        assert_eq!(action(ctrl_shift_c), Some(Action::Quit));
         assert_eq!(action(press(KeyCode::Char('x'))), None);
         let ctrl_t = KeyEvent::new(KeyCode::Char('t'), KeyModifiers::CONTROL);
         assert_eq!(action(ctrl_t), None);

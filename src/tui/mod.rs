@@ -7,9 +7,11 @@
 //! something happens, and never busy-waits.
 pub mod app;
 pub mod canvas;
+pub mod chart;
 pub mod guard;
 pub mod help;
 pub mod input;
+pub mod keys;
 pub mod output;
 pub mod projection;
 pub mod readouts;

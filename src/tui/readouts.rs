@@ -1,13 +1,13 @@
 //! The readouts panel: every figure as text in a fixed place, so values
 //! change without the layout moving.
-use super::state::{AppState, physics_threads};
+use super::state::{AppState, physics_threads, representative_radius};
 use super::theme::Palette;
 use crate::engine::{Snapshot, Threading};
 use crate::physics::ModelKind;
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
 use ratatui::text::{Line, Span};
-use ratatui::widgets::{Block, Paragraph, Widget};
+use ratatui::widgets::{Block, Paragraph, Widget, Wrap};
 
 /// Figures the frame loop measures (the rest come from the snapshot).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -26,8 +26,15 @@ pub struct Stats {
     pub detected: Option<Palette>,
 }
 
-/// 16 rows and the border.
-pub const HEIGHT: u16 = 18;
+/// Rows of figures in the full form, and of the compact one.
+const FULL_ROWS: u16 = 15;
+const COMPACT_ROWS: u16 = 7;
+/// Rows kept for a notice, so a long one wraps instead of being cut.
+const NOTICE_ROWS: u16 = 2;
+/// The full panel: its rows, the notice and the border.
+pub const HEIGHT: u16 = FULL_ROWS + NOTICE_ROWS + 2;
+/// The compact panel, for short terminals.
+pub const COMPACT_HEIGHT: u16 = COMPACT_ROWS + NOTICE_ROWS + 2;
 
 pub struct Readouts<'a> {
     pub state: &'a AppState,
@@ -37,6 +44,59 @@ pub struct Readouts<'a> {
 }
 
 impl Readouts<'_> {
+    fn threading(&self) -> String {
+        let s = self.state;
+        let threads = physics_threads(s.threading, s.threads);
+        match s.threading {
+            Threading::Off => format!("off      on main; t -> {}", s.last_threaded),
+            // The event loop of `exact` does not split: say where it runs.
+            t @ (Threading::Pool | Threading::Split) if s.model == ModelKind::Exact => {
+                format!("{:<8} exact runs on physics", t.name())
+            }
+            t => format!(
+                "{:<8} {threads} physics thread{}",
+                t.name(),
+                if threads == 1 { "" } else { "s" }
+            ),
+        }
+    }
+
+    /// The frame rate, or why there is none: paused and frozen screens
+    /// are only redrawn when something changes.
+    fn fps(&self, compact: bool) -> String {
+        let s = self.state;
+        match (s.paused, s.tick) {
+            (true, _) => "paused".into(),
+            (false, 0) if compact => "frozen".into(),
+            (false, 0) => "frozen (tick 0)".into(),
+            _ if compact => format!("{:.1} of {}", self.stats.fps, s.fps),
+            _ => format!("{:<8.1} target {}", self.stats.fps, s.fps),
+        }
+    }
+
+    /// The radius in force: the snapshot's, never the one asked for.
+    fn radius(&self) -> String {
+        representative_radius(self.snap).map_or_else(|| "-".into(), |r| format!("{r:.5}"))
+    }
+
+    fn physics_ms(&self) -> String {
+        if self.state.running() {
+            format!("{:.2} ms", self.stats.physics_seconds * 1e3)
+        } else {
+            "idle".into()
+        }
+    }
+
+    fn colour(&self) -> String {
+        match self.stats.detected {
+            Some(d) if d != self.palette => {
+                format!("{} (terminal: {})", self.palette.name(), d.name())
+            }
+            _ => self.palette.name().to_string(),
+        }
+    }
+
+    /// Every figure, one a row (tall terminals).
     pub fn lines(&self) -> Vec<Line<'static>> {
         let s = self.state;
         let snap = self.snap;
@@ -48,19 +108,6 @@ impl Readouts<'_> {
                 Span::raw(value),
             ])
         };
-        let threads = physics_threads(s.threading, s.threads);
-        let threading = match s.threading {
-            Threading::Off => format!("off      on main; t -> {}", s.last_threaded),
-            // The event loop of `exact` does not split: say where it runs.
-            t @ (Threading::Pool | Threading::Split) if s.model == ModelKind::Exact => {
-                format!("{:<8} exact runs on physics", t.name())
-            }
-            t => format!(
-                "{:<8} {threads} physics thread{}",
-                t.name(),
-                if threads == 1 { "" } else { "s" }
-            ),
-        };
         let mut tick = format!(
             "{:<8} step{}/frame",
             s.tick,
@@ -69,29 +116,29 @@ impl Readouts<'_> {
         if s.tick == 0 {
             tick.push_str("  frozen");
         }
-        let collisions = format!("{:<8.0} per s", st.collisions_per_second);
-        let colour = match st.detected {
-            Some(d) if d != self.palette => {
-                format!("{} (terminal: {})", self.palette.name(), d.name())
-            }
-            _ => self.palette.name().to_string(),
-        };
-        let mut lines = vec![
-            row("threading", threading),
+        vec![
+            row("threading", self.threading()),
             row("tick", tick),
             row("count", format!("{}", snap.spheres.len())),
-            row("radius", format!("{:.5}", s.radius)),
+            row("radius", self.radius()),
             row("model", model_row(s.model, snap.parts)),
             row("style", s.style.name().to_string()),
-            row("colour", colour),
-            row("fps", format!("{:<8.1} target {}", st.fps, s.fps)),
+            row("colour", self.colour()),
+            row("fps", self.fps(false)),
             row(
                 "physics",
-                format!("{:<8.2} ms/frame", st.physics_seconds * 1e3),
+                if s.running() {
+                    format!("{:<8} per frame", self.physics_ms())
+                } else {
+                    self.physics_ms()
+                },
             ),
             row(
                 "render",
-                format!("{:<8.2} ms/frame", st.render_seconds * 1e3),
+                format!(
+                    "{:<8} per frame",
+                    format!("{:.2} ms", st.render_seconds * 1e3)
+                ),
             ),
             row("steps/s", format!("{:<8.0}", st.steps_per_second)),
             row(
@@ -105,29 +152,88 @@ impl Readouts<'_> {
                     snap.max_overlap_rel, snap.escaped
                 ),
             ),
-            row("collisions", collisions),
+            row(
+                "collisions",
+                format!("{:<8.0} per s", st.collisions_per_second),
+            ),
             row(
                 "output",
                 format!("{:<8} per frame", human_bytes(st.frame_bytes)),
             ),
-        ];
-        if s.paused {
-            lines.push(Line::from(Span::styled(
-                " PAUSED (space resumes) ",
-                self.palette.alert(),
-            )));
-        } else if let Some(n) = &s.notice {
-            lines.push(Line::from(Span::styled(n.clone(), self.palette.alert())));
-        } else if snap.counters.capped_steps > 0 {
-            // A capped step skipped contacts: say so, it explains overlaps.
-            lines.push(Line::from(Span::styled(
-                format!(" event cap hit in {} steps ", snap.counters.capped_steps),
-                self.palette.alert(),
-            )));
+        ]
+    }
+
+    /// The same figures two to a row (80x24 and other short terminals).
+    pub fn compact_lines(&self) -> Vec<Line<'static>> {
+        let s = self.state;
+        let snap = self.snap;
+        let st = self.stats;
+        let label = self.palette.label();
+        let pair = |a: &str, av: String, b: &str, bv: String| {
+            Line::from(vec![
+                Span::styled(format!("{a:<8}"), label),
+                Span::raw(format!("{av:<13}")),
+                Span::styled(format!("{b:<8}"), label),
+                Span::raw(bv),
+            ])
+        };
+        let model = if snap.parts > 1 {
+            format!("{} cut {}", s.model.name(), snap.parts)
         } else {
-            lines.push(Line::from(""));
+            s.model.name().to_string()
+        };
+        vec![
+            Line::from(vec![
+                Span::styled("threading  ", label),
+                Span::raw(self.threading()),
+            ]),
+            pair(
+                "tick",
+                // The number first and alone, as in the full form, so a
+                // reader (or a test) takes the tick from the first word.
+                format!("{} step{}", s.tick, if s.tick == 1 { "" } else { "s" }),
+                "count",
+                snap.spheres.len().to_string(),
+            ),
+            pair("radius", self.radius(), "model", model),
+            pair("fps", self.fps(true), "physics", self.physics_ms()),
+            pair(
+                "render",
+                format!("{:.2} ms", st.render_seconds * 1e3),
+                "output",
+                format!("{}/fr", human_bytes(st.frame_bytes)),
+            ),
+            pair(
+                "drift",
+                format!("{:.1e}", snap.energy_drift()),
+                "overlap",
+                format!("{:.1e} esc {}", snap.max_overlap_rel, snap.escaped),
+            ),
+            pair(
+                "steps",
+                format!("{:.0}/s", st.steps_per_second),
+                "coll",
+                format!("{:.0}/s", st.collisions_per_second),
+            ),
+        ]
+    }
+
+    /// The line under the figures: pause, a notice, or the event cap.
+    fn notice(&self) -> Option<String> {
+        let s = self.state;
+        if s.paused {
+            Some(" PAUSED (space resumes) ".into())
+        } else if let Some(n) = &s.notice {
+            Some(format!(" {n} "))
+        } else if self.snap.counters.capped_steps > 0 {
+            // A capped step skipped contacts: say so, it explains overlaps.
+            Some(format!(
+                " event cap hit in {} steps ",
+                self.snap.counters.capped_steps
+            ))
+        } else {
+            None
         }
-        lines
     }
 }
 
@@ -142,10 +248,35 @@ fn model_row(model: ModelKind, parts: u32) -> String {
 }
 
 impl Widget for Readouts<'_> {
+    /// The full form when the area has room for it, else the compact one;
+    /// the notice wraps in the rows left under the figures.
     fn render(self, area: Rect, buf: &mut Buffer) {
-        Paragraph::new(self.lines())
-            .block(Block::bordered().title(" ballpit "))
-            .render(area, buf);
+        let block = Block::bordered().title(" ballpit ");
+        let inner = block.inner(area);
+        block.render(area, buf);
+        let lines = if inner.height >= FULL_ROWS + NOTICE_ROWS && inner.width >= 42 {
+            self.lines()
+        } else {
+            self.compact_lines()
+        };
+        let rows = (lines.len() as u16).min(inner.height);
+        Paragraph::new(lines).render(
+            Rect {
+                height: rows,
+                ..inner
+            },
+            buf,
+        );
+        if let Some(n) = self.notice() {
+            let r = Rect {
+                y: inner.y + rows,
+                height: inner.height - rows,
+                ..inner
+            };
+            Paragraph::new(Span::styled(n, self.palette.alert()))
+                .wrap(Wrap { trim: false })
+                .render(r, buf);
+        }
     }
 }
 

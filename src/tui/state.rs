@@ -30,6 +30,8 @@ pub struct AppState {
     pub style: DrawStyle,
     pub light: u8,
     pub help: bool,
+    /// The chart of per-thread CPU is shown in place of the canvas.
+    pub chart: bool,
     pub fps: f64,
     pub quit: bool,
     /// A limit a key ran into, shown until the next key.
@@ -55,6 +57,7 @@ impl AppState {
             style: DrawStyle::PointsSpeed,
             light: 0,
             help: false,
+            chart: false,
             fps,
             quit: false,
             notice: None,
@@ -113,8 +116,18 @@ impl AppState {
                     self.threads = want;
                     out.push(Command::SetThreads(want));
                 }
-                if self.threading != Threading::Pool && self.notice.is_none() {
-                    self.notice = Some(format!("pool threads {want} (used in pool mode)"));
+                // The size is kept and sent either way; say when it has no
+                // effect yet, so the key does not seem to do nothing.
+                if self.notice.is_none() {
+                    if self.threading != Threading::Pool {
+                        self.notice = Some(format!(
+                            "pool threads {want}: kept for pool mode (now {})",
+                            self.threading
+                        ));
+                    } else if self.model == ModelKind::Exact {
+                        self.notice =
+                            Some(format!("pool threads {want}: exact runs on one thread"));
+                    }
                 }
             }
             Action::TickDown => {
@@ -122,6 +135,7 @@ impl AppState {
                     self.notice = Some("tick 0: physics frozen".into());
                 } else {
                     self.tick -= 1;
+                    self.tell_if_paused();
                 }
             }
             Action::TickUp => {
@@ -129,6 +143,7 @@ impl AppState {
                     self.notice = Some(format!("tick limit: {MAX_TICK}"));
                 } else {
                     self.tick += 1;
+                    self.tell_if_paused();
                 }
             }
             Action::Pause => self.paused = !self.paused,
@@ -172,10 +187,11 @@ impl AppState {
             Action::CycleStyle => self.style = self.style.next(),
             Action::MoveLight => {
                 self.light = (self.light + 1) % LIGHT_STEPS;
-                if self.style != DrawStyle::Shaded {
+                if self.style != DrawStyle::Shaded && !self.chart {
                     self.notice = Some("the light shows in the shaded style (v)".into());
                 }
             }
+            Action::Chart => self.chart = !self.chart,
             Action::Reset => out.push(Command::Reset),
             Action::Help => self.help = !self.help,
             Action::SlowerFps => match FPS_STEPS.iter().rev().find(|&&f| f < self.fps - 1e-9) {
@@ -189,7 +205,27 @@ impl AppState {
                 }
             },
         }
+        if self.chart
+            && matches!(
+                action,
+                Action::Left
+                    | Action::Right
+                    | Action::Up
+                    | Action::Down
+                    | Action::CycleStyle
+                    | Action::MoveLight
+            )
+        {
+            self.notice = Some("the view changed behind the chart (c shows it)".into());
+        }
         out
+    }
+
+    /// The tick is kept while paused; it runs on resume.
+    fn tell_if_paused(&mut self) {
+        if self.paused {
+            self.notice = Some(format!("tick {}: runs when resumed (space)", self.tick));
+        }
     }
 
     /// Take what the engine really did (count and radius may stop at a

@@ -1,0 +1,248 @@
+//! The one key table: dispatch (`input::action`), the `?` overlay, the key
+//! bar and the README check (tests/readme_keys.rs) all read `TABLE`, so a
+//! key cannot be added in one place and forgotten in another.
+use super::input::Action;
+
+/// A key as the table names it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Press {
+    Char(char),
+    Esc,
+    Left,
+    Right,
+    Up,
+    Down,
+    /// With Control held (the letter in lower case).
+    Ctrl(char),
+}
+
+impl Press {
+    fn is_arrow(self) -> bool {
+        matches!(self, Press::Left | Press::Right | Press::Up | Press::Down)
+    }
+
+    /// The name the README's "## Keys" table uses: `q`, `space`, `Esc`,
+    /// `Ctrl-C`, and `←` `→` `↑` `↓` for the arrow keys.
+    pub fn doc_name(self) -> String {
+        match self {
+            Press::Ctrl(c) => format!("Ctrl-{}", c.to_ascii_uppercase()),
+            other => other.short(),
+        }
+    }
+
+    /// The short form for the bar and the overlay.
+    fn short(self) -> String {
+        match self {
+            Press::Char(' ') => "space".into(),
+            Press::Char(c) => c.to_string(),
+            Press::Esc => "Esc".into(),
+            Press::Ctrl(c) => format!("^{}", c.to_ascii_uppercase()),
+            Press::Left => "←".into(),
+            Press::Right => "→".into(),
+            Press::Up => "↑".into(),
+            Press::Down => "↓".into(),
+        }
+    }
+}
+
+/// One line of help: the keys, what each does, and its place in the bar.
+#[derive(Debug)]
+pub struct Binding {
+    pub presses: &'static [(Press, Action)],
+    /// The `?` overlay's description.
+    pub help: &'static str,
+    /// The key bar's label and rank (0 is kept first when columns run out).
+    pub bar: Option<(&'static str, u8)>,
+}
+
+impl Binding {
+    /// The keys as the overlay shows them: `p/P`, `q/Esc/^C`, `arrows`.
+    pub fn keys(&self) -> String {
+        if self.presses.iter().all(|(p, _)| p.is_arrow()) {
+            return "arrows".into();
+        }
+        let names: Vec<String> = self.presses.iter().map(|(p, _)| p.short()).collect();
+        names.join("/")
+    }
+
+    /// The keys as the bar shows them (shorter where it can be).
+    pub fn bar_keys(&self) -> String {
+        if self.presses.iter().all(|(p, _)| p.is_arrow()) {
+            return self.presses.iter().map(|(p, _)| p.short()).collect();
+        }
+        match self.presses {
+            [(Press::Char(' '), _)] => "spc".into(),
+            // The bar has no room for every way to quit; the overlay lists them.
+            [(first, _), ..] if *first == Press::Char('q') => "q".into(),
+            _ => self.keys(),
+        }
+    }
+}
+
+use Action as A;
+use Press as K;
+
+pub const TABLE: &[Binding] = &[
+    Binding {
+        presses: &[(K::Char('?'), A::Help)],
+        help: "this help",
+        bar: Some(("help", 0)),
+    },
+    Binding {
+        presses: &[
+            (K::Char('q'), A::Quit),
+            (K::Esc, A::Escape),
+            (K::Ctrl('c'), A::Quit),
+        ],
+        help: "quit (Esc first closes this help)",
+        bar: Some(("quit", 1)),
+    },
+    Binding {
+        presses: &[(K::Char('t'), A::ToggleThreading)],
+        help: "threading on/off (off <-> last threaded mode)",
+        bar: Some(("thread", 2)),
+    },
+    Binding {
+        presses: &[(K::Char('d'), A::CycleThreadedMode)],
+        help: "cycle threaded mode: worker -> pool -> split",
+        bar: Some(("mode", 3)),
+    },
+    Binding {
+        presses: &[
+            (K::Char('p'), A::FewerThreads),
+            (K::Char('P'), A::MoreThreads),
+        ],
+        help: "pool threads - / + (used in pool mode)",
+        bar: Some(("pool", 5)),
+    },
+    Binding {
+        presses: &[(K::Char('c'), A::Chart)],
+        help: "chart of per-thread CPU, last minute / canvas",
+        bar: Some(("chart", 4)),
+    },
+    Binding {
+        presses: &[(K::Char('['), A::TickDown), (K::Char(']'), A::TickUp)],
+        help: "physics tick - / + (0 freezes)",
+        bar: Some(("tick", 7)),
+    },
+    Binding {
+        presses: &[(K::Char(' '), A::Pause)],
+        help: "pause / resume",
+        bar: Some(("pause", 6)),
+    },
+    Binding {
+        presses: &[
+            (K::Char('n'), A::HalveCount),
+            (K::Char('N'), A::DoubleCount),
+        ],
+        help: "sphere count /2 / x2",
+        bar: Some(("count", 8)),
+    },
+    Binding {
+        presses: &[(K::Char('r'), A::Smaller), (K::Char('R'), A::Bigger)],
+        help: "sphere radius smaller / bigger",
+        bar: Some(("size", 9)),
+    },
+    Binding {
+        presses: &[(K::Char('m'), A::CycleModel)],
+        help: "cycle collision model",
+        bar: Some(("model", 10)),
+    },
+    Binding {
+        presses: &[
+            (K::Left, A::Left),
+            (K::Right, A::Right),
+            (K::Up, A::Up),
+            (K::Down, A::Down),
+        ],
+        help: "rotate the camera",
+        bar: Some(("camera", 12)),
+    },
+    Binding {
+        presses: &[(K::Char('v'), A::CycleStyle)],
+        help: "cycle drawing style (braille / shaded blocks)",
+        bar: Some(("style", 11)),
+    },
+    Binding {
+        presses: &[(K::Char('l'), A::MoveLight)],
+        help: "move the light (shaded style)",
+        bar: Some(("light", 14)),
+    },
+    Binding {
+        presses: &[(K::Char('0'), A::Reset)],
+        help: "reset the scene",
+        bar: Some(("reset", 13)),
+    },
+    Binding {
+        presses: &[(K::Char('f'), A::SlowerFps), (K::Char('F'), A::FasterFps)],
+        help: "frame rate - / +",
+        bar: Some(("fps", 15)),
+    },
+];
+
+/// What `press` does, if anything.
+pub fn lookup(press: Press) -> Option<Action> {
+    TABLE
+        .iter()
+        .flat_map(|b| b.presses)
+        .find(|(p, _)| *p == press)
+        .map(|&(_, a)| a)
+}
+
+/// The bar's entries that fit in `width` columns, the most useful first
+/// chosen, shown in table order. Each takes `keys label ` columns.
+pub fn bar_entries(width: usize) -> Vec<(String, &'static str)> {
+    let mut ranked: Vec<(usize, u8, String, &'static str)> = TABLE
+        .iter()
+        .enumerate()
+        .filter_map(|(i, b)| b.bar.map(|(label, rank)| (i, rank, b.bar_keys(), label)))
+        .collect();
+    ranked.sort_by_key(|e| e.1);
+    let mut used = 0;
+    let mut chosen = Vec::new();
+    for e in ranked {
+        let w = bar_width(&e.2, e.3);
+        if used + w <= width + 1 {
+            used += w;
+            chosen.push(e);
+        }
+    }
+    chosen.sort_by_key(|e| e.0);
+    chosen.into_iter().map(|e| (e.2, e.3)).collect()
+}
+
+/// Columns one bar entry takes, its trailing space included.
+pub fn bar_width(keys: &str, label: &str) -> usize {
+    keys.chars().count() + 1 + label.len() + 1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn no_key_is_bound_twice() {
+        let all: Vec<Press> = TABLE
+            .iter()
+            .flat_map(|b| b.presses.iter().map(|p| p.0))
+            .collect();
+        for (i, p) in all.iter().enumerate() {
+            assert!(!all[i + 1..].contains(p), "{p:?} bound twice");
+        }
+    }
+
+    #[test]
+    fn the_bar_keeps_the_first_ranks_and_fits() {
+        for width in [20, 40, 80, 120, 200] {
+            let e = bar_entries(width);
+            let used: usize = e.iter().map(|(k, l)| bar_width(k, l)).sum();
+            assert!(used <= width + 1, "{width}: {used}");
+            assert_eq!(e[0], ("?".to_string(), "help"));
+        }
+        let at80: Vec<&str> = bar_entries(80).iter().map(|e| e.1).collect();
+        for must in ["help", "quit", "thread", "mode", "chart", "pool", "pause"] {
+            assert!(at80.contains(&must), "{must} missing at 80: {at80:?}");
+        }
+        assert_eq!(bar_entries(200).len(), TABLE.len());
+    }
+}
