@@ -12,9 +12,11 @@ pub mod help;
 pub mod input;
 pub mod output;
 pub mod projection;
+pub mod reader;
 pub mod readouts;
 pub mod run;
 pub mod state;
+pub mod term_input;
 pub mod theme;
 pub mod threads;
 

@@ -1,12 +1,12 @@
 //! The frame loop and its pacing.
 use super::app::{self, View};
 use super::canvas::Raster;
-use super::guard::{self, Guard, Msg};
+use super::guard::{self, Gated, Guard, Msg};
 use super::output::{BEGIN_SYNC, BUFFER_BYTES, Counting, END_SYNC, Lean};
 use super::readouts::Stats;
 use super::state::AppState;
 use super::theme::Palette;
-use super::{Options, input};
+use super::{Options, input, reader};
 use crate::cpu::{CpuReport, Sampler};
 use crate::engine::{Command, Engine, Settings, Snapshot};
 use crate::error::BadInput;
@@ -27,7 +27,7 @@ const SAMPLE_PERIOD: Duration = Duration::from_secs(1);
 pub fn run(world: World, settings: Settings, opts: Options) -> anyhow::Result<()> {
     if !(opts.fps.is_finite() && opts.fps > 0.0 && opts.fps <= 1000.0) {
         return Err(BadInput(format!(
-            "--fps must be between 0 and 1000, got {}",
+            "--fps must be greater than 0 and at most 1000, got {}",
             opts.fps
         ))
         .into());
@@ -57,7 +57,7 @@ pub fn run(world: World, settings: Settings, opts: Options) -> anyhow::Result<()
     let (tx, rx) = crossbeam_channel::unbounded();
     let guard = Guard::enter(tx.clone()).context("cannot set up the terminal")?;
     let signals = guard::spawn_signals(tx.clone())?;
-    guard::spawn_input(tx)?;
+    reader::spawn_input(tx)?;
     // For the end-to-end test of a panic off the main thread.
     if std::env::var_os("BALLPIT_TEST_PANIC_THREAD").is_some() {
         std::thread::Builder::new()
@@ -67,13 +67,18 @@ pub fn run(world: World, settings: Settings, opts: Options) -> anyhow::Result<()
                 panic!("test panic in a worker thread");
             })?;
     }
-    let result = FrameLoop::new(engine, state, palette, detected).and_then(|l| l.run(rx));
+    let mut result = FrameLoop::new(engine, state, palette, detected).and_then(|l| l.run(rx));
+    // A panic restores the terminal, so the frame loop may stop on a refused
+    // write first: the panic is the reason to report.
+    if result.is_err() && guard::panicked() {
+        result = Err(anyhow!("a thread panicked (message above)"));
+    }
     signals.close();
     drop(guard);
     result
 }
 
-type Term = Terminal<Lean<Counting<BufWriter<Stdout>>>>;
+type Term = Terminal<Lean<Counting<BufWriter<Gated<Stdout>>>>>;
 
 struct FrameLoop {
     engine: Engine,
@@ -117,7 +122,10 @@ impl FrameLoop {
         palette: Palette,
         detected: Palette,
     ) -> anyhow::Result<FrameLoop> {
-        let (writer, bytes) = Counting::new(BufWriter::with_capacity(BUFFER_BYTES, io::stdout()));
+        let (writer, bytes) = Counting::new(BufWriter::with_capacity(
+            BUFFER_BYTES,
+            guard::gated_stdout(),
+        ));
         let mut terminal = Terminal::new(Lean::new(writer))?;
         // Not `Terminal::clear`: it asks the terminal for the cursor position,
         // a round trip that a slow link or a dumb pty may never answer.
