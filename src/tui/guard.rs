@@ -16,6 +16,10 @@ use std::time::Duration;
 #[derive(Clone, Debug, PartialEq)]
 pub enum Msg {
     Key(KeyEvent),
+    /// The terminal answered a status request (read at that instant).
+    Status(std::time::Instant),
+    /// The `output` thread finished writing a chunk.
+    Written,
     Resize,
     /// A termination signal (its number).
     Signal(i32),

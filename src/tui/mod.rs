@@ -11,6 +11,7 @@ pub mod guard;
 pub mod help;
 pub mod input;
 pub mod output;
+pub mod pacing;
 pub mod projection;
 pub mod reader;
 pub mod readouts;
@@ -19,6 +20,7 @@ pub mod state;
 pub mod term_input;
 pub mod theme;
 pub mod threads;
+pub mod writer;
 
 pub use run::run;
 pub use theme::ColorChoice;

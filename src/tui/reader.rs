@@ -11,7 +11,7 @@ use rustix::event::{PollFd, PollFlags, Timespec};
 use std::io;
 use std::os::fd::AsFd;
 use std::thread;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 /// How long a lone Esc waits for the rest of a sequence. Terminals send a
 /// sequence in one write; a person cannot type Esc and `[` this fast.
@@ -64,10 +64,10 @@ fn read_loop(tx: &Sender<Msg>) -> Option<String> {
         for ev in events.drain(..) {
             let msg = match ev {
                 Input::Key(k) => Msg::Key(k),
-                // Pastes, focus changes and reports are not commands.
-                Input::StatusOk | Input::Cursor(..) | Input::Focus(_) | Input::Paste(_) => {
-                    continue;
-                }
+                // The pacing's answers: when they were read.
+                Input::StatusOk => Msg::Status(Instant::now()),
+                // Pastes, focus changes and cursor reports are not commands.
+                Input::Cursor(..) | Input::Focus(_) | Input::Paste(_) => continue,
             };
             if tx.send(msg).is_err() {
                 return None;

@@ -24,6 +24,8 @@ pub struct Stats {
     pub collisions_per_second: f64,
     /// The palette the terminal says it can do.
     pub detected: Option<Palette>,
+    /// The link to the terminal as the pacing sees it (run.rs, pacing.rs).
+    pub link: Option<String>,
 }
 
 /// 16 rows and the border.
@@ -108,7 +110,10 @@ impl Readouts<'_> {
             row("collisions", collisions),
             row(
                 "output",
-                format!("{:<8} per frame", human_bytes(st.frame_bytes)),
+                match &st.link {
+                    Some(link) => format!("{:<8} {link}", human_bytes(st.frame_bytes)),
+                    None => format!("{:<8} per frame", human_bytes(st.frame_bytes)),
+                },
             ),
         ];
         if s.paused {
