@@ -1,6 +1,7 @@
 //! Key-to-screen latency of the real binary over an emulated slow link
 //! (issue 16). Run `cargo build --release` first, then
-//! `cargo run --release --example slow_link -- [KEYS] [BIN]`.
+//! `cargo run --release --example slow_link -- [KEYS] [BIN] [ONLY]`
+//! (ONLY: run just the links whose name contains it).
 //! Prints, per link, the median and worst latency of KEYS presses of `v`
 //! at random moments, the frames per second shown by the app, and the
 //! bytes per second and per frame the screen received.
@@ -31,7 +32,11 @@ fn main() {
         ("16 KB/s, 50 ms", Some(16_000.0), 50, true),
         ("unlimited, no answers", None, 0, false),
     ];
+    let only = args.get(3).cloned().unwrap_or_default();
     for (name, rate, delay, answers) in links {
+        if !name.contains(only.as_str()) {
+            continue;
+        }
         let mut spec = Spec::new(rate, delay);
         spec.answers = answers;
         let mut link = Link::start(CommandBuilder::new(&bin), spec);
@@ -43,6 +48,8 @@ fn main() {
             Duration::from_millis(600),
         );
         let (median, worst) = summary(&lat);
+        let each: Vec<u128> = lat.iter().map(|d| d.as_millis()).collect();
+        eprintln!("{name}: each key, ms: {each:?}");
         // Throughput and frame rate over the next 3 s.
         let b0 = link.delivered.load(Ordering::Relaxed);
         let t0 = Instant::now();

@@ -26,10 +26,13 @@ const FAST: Duration = Duration::from_millis(3);
 /// Frames in flight on a fast link: a long round trip then does not cap
 /// the frame rate (30 fps over a 100 ms round trip needs three).
 const FAST_IN_FLIGHT: usize = 4;
-/// The idle gap after a frame, as a fraction of the time it took to cross
-/// the link: a key's update finds the link free about half of the time, and
-/// waits for at most one frame otherwise.
-const GAP: f64 = 1.0;
+/// Below this rate frames drop their colours (about half the bytes): 30
+/// coloured frames a second take 130-180 KB/s at 120x40.
+const CHEAP_RATE: f64 = 100_000.0;
+/// On a slow link a second frame may follow the one in flight only if both
+/// cross in this time: a key's update then waits behind at most this much
+/// (or one frame), and a long round trip does not cap the frame rate.
+const QUEUE_BUDGET: f64 = 0.1;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mode {
@@ -65,8 +68,8 @@ pub struct Pacer {
     rtt: Option<f64>,
     /// Bytes per second the link carries, when it is slow enough to tell.
     rate: Option<f64>,
-    /// No full frame before this: the link's idle gap.
-    idle_until: Instant,
+    /// The size of the last frames answered (a slowly forgetting maximum).
+    last_bytes: usize,
     /// Seconds the last answered frame took to cross the link.
     last_transfer: f64,
     /// When the question before the frame now crossing was answered.
@@ -85,7 +88,7 @@ impl Pacer {
             unwritten: 0,
             rtt: None,
             rate: None,
-            idle_until: now,
+            last_bytes: 0,
             last_transfer: 0.0,
             started: None,
             measured: false,
@@ -117,6 +120,13 @@ impl Pacer {
                 || self.rtt.is_some_and(|r| r > 4.0 * FAST.as_secs_f64()))
     }
 
+    /// Whether frames should be cheaper (no colours): the link is measured
+    /// slow. The rate is the link's, not the frames', so this does not flip
+    /// back and forth as the frames shrink.
+    pub fn cheap(&self) -> bool {
+        self.slow() && self.rate.is_some_and(|r| r < CHEAP_RATE)
+    }
+
     /// A chunk of `bytes` was handed to the writer, between two questions
     /// or without any.
     pub fn sent(&mut self, now: Instant, bytes: usize, asked: bool) {
@@ -146,6 +156,11 @@ impl Pacer {
         } else {
             1
         }
+    }
+
+    /// Bytes of the frames not yet on screen.
+    fn bytes_in_flight(&self) -> usize {
+        self.in_flight.iter().map(|s| s.bytes).sum()
     }
 
     /// Frames sent and not yet on screen.
@@ -192,9 +207,9 @@ impl Pacer {
                 self.rate = Some(self.rate.map_or(sample, |r| r + 0.3 * (sample - r)));
             }
         }
-        // Leave the link idle for a while after a frame.
-        let gap = Duration::from_secs_f64(GAP * self.last_transfer);
-        self.idle_until = now + if gap < FAST { Duration::ZERO } else { gap };
+        if s.bytes >= 512 {
+            self.last_bytes = s.bytes.max(self.last_bytes / 2);
+        }
     }
 
     /// Time passes: the probe or an answer may be overdue.
@@ -218,10 +233,18 @@ impl Pacer {
     }
 
     /// Whether a full frame may go out now.
-    pub fn may_send(&self, now: Instant) -> bool {
+    pub fn may_send(&self) -> bool {
         match self.mode {
             Mode::Probing => false,
-            Mode::Paced => self.frames_in_flight() < self.fast_limit() && now >= self.idle_until,
+            Mode::Paced => {
+                let frames = self.frames_in_flight();
+                frames == 0
+                    || frames < self.fast_limit()
+                    || self.rate.is_some_and(|r| {
+                        let queued = self.bytes_in_flight() + self.last_bytes;
+                        self.slow() && queued as f64 <= r * QUEUE_BUDGET
+                    })
+            }
             Mode::Unpaced => self.unwritten == 0,
         }
     }
@@ -240,10 +263,7 @@ impl Pacer {
     pub fn next_change(&self) -> Option<Instant> {
         match self.mode {
             Mode::Probing => Some(self.probe_deadline),
-            Mode::Paced => match self.in_flight.front() {
-                Some(s) => Some(s.at + ANSWER_TIMEOUT),
-                None => Some(self.idle_until),
-            },
+            Mode::Paced => self.in_flight.front().map(|s| s.at + ANSWER_TIMEOUT),
             Mode::Unpaced => None,
         }
     }
@@ -255,13 +275,19 @@ impl Pacer {
             Mode::Unpaced => "link: no answers".into(),
             Mode::Paced => {
                 let rtt = self.rtt.unwrap_or(0.0);
-                let frame = rtt + 2.0 * self.last_transfer;
+                // One frame per round trip and crossing, or per crossing
+                // when two fit the budget.
+                let pipelined = self
+                    .rate
+                    .is_some_and(|r| 2.0 * self.last_bytes as f64 <= r * QUEUE_BUDGET);
+                let frame = self.last_transfer + if pipelined { 0.0 } else { rtt };
                 match self.rate {
                     Some(r) if self.last_transfer > FAST.as_secs_f64() => format!(
-                        "{:.0}ms {:.0}KB/s ≤{:.1}fps",
+                        "{:.0}ms {:.0}KB/s {:.0}fps{}",
                         rtt * 1e3,
                         r / 1e3,
-                        1.0 / frame.max(1e-3)
+                        1.0 / frame.max(1e-3),
+                        if self.cheap() { " mono" } else { "" }
                     ),
                     _ => format!("link fast, rtt {:.0}ms", rtt * 1e3),
                 }
@@ -278,60 +304,88 @@ mod tests {
         Duration::from_millis(n)
     }
 
+    /// Send a frame and have both of its questions answered.
+    fn frame(p: &mut Pacer, at: Instant, bytes: usize, rtt: u64, transfer: u64) {
+        p.sent(at, bytes, true);
+        p.answered(at + ms(rtt));
+        p.answered(at + ms(rtt + transfer));
+    }
+
     #[test]
-    fn a_terminal_that_answers_is_paced_one_frame_at_a_time() {
+    fn a_slow_link_is_measured_and_gets_one_frame_at_a_time() {
         let t0 = Instant::now();
         let mut p = Pacer::new(t0);
-        assert!(!p.may_send(t0));
+        assert!(!p.may_send(), "probing");
         p.written();
         p.answered(t0 + ms(100));
         assert_eq!(p.mode(), Mode::Paced);
-        let t = t0 + ms(100);
-        assert!(p.may_send(t));
+        assert!(p.asks());
+        assert!(p.may_send());
         // A 6 KB frame at 16 KB/s on a 100 ms round trip: the question
         // before it is answered after 100 ms, the one after it 375 ms later.
+        let t = t0 + ms(100);
+        frame(&mut p, t, 6000, 100, 375);
+        assert!((p.rtt.unwrap() - 0.1).abs() < 1e-9, "{:?}", p.rtt);
+        let rate = p.rate.unwrap();
+        assert!((rate - 16_000.0).abs() < 100.0, "{rate}");
+        assert!(p.slow());
+        assert!(p.cheap(), "16 KB/s is too slow for colours");
+        assert!(p.describe().contains("16KB/s"), "{}", p.describe());
+        // One frame in flight: two would not cross in the budget.
+        let t = t + ms(500);
+        assert!(p.may_send());
         p.sent(t, 6000, true);
-        assert!(!p.may_send(t + ms(10)));
+        assert!(!p.may_send());
+        // A key's update may follow it, and nothing more.
         assert!(p.may_send_update());
         p.sent(t + ms(10), 100, true);
         assert!(!p.may_send_update(), "at most two frames in flight");
         p.answered(t + ms(100));
         p.answered(t + ms(475));
-        assert!(!p.may_send(t + ms(476)), "the update is still unanswered");
+        assert!(!p.may_send(), "the update is still unanswered");
         // The update's round trip waited behind the frame: not a sample.
         p.answered(t + ms(476));
         p.answered(t + ms(480));
         assert!((p.rtt.unwrap() - 0.1).abs() < 1e-9, "{:?}", p.rtt);
-        // The link stays idle as long as the frame took to cross it.
-        assert!(!p.may_send(t + ms(480 + 374)));
-        assert!(p.may_send(t + ms(480 + 375)));
-        assert!(p.slow());
-        let rate = p.rate.unwrap();
-        assert!((rate - 16_000.0).abs() < 200.0, "{rate}");
-        assert!(p.describe().contains("16KB/s"), "{}", p.describe());
+        assert!(p.may_send());
     }
 
     #[test]
-    fn a_fast_link_has_no_gap() {
+    fn a_moderate_link_takes_a_second_frame_when_both_fit_the_budget() {
+        let t0 = Instant::now();
+        let mut p = Pacer::new(t0);
+        p.answered(t0 + ms(100));
+        // 2 KB frames at 64 KB/s: 31 ms each; two fit in 100 ms.
+        let t = t0 + ms(100);
+        frame(&mut p, t, 2000, 100, 31);
+        assert!(p.slow() && p.cheap());
+        p.sent(t + ms(200), 2000, true);
+        assert!(p.may_send(), "a second frame fits");
+        p.sent(t + ms(233), 2000, true);
+        assert!(p.may_send(), "a third still fits in 6.4 KB");
+        p.sent(t + ms(266), 2000, true);
+        assert!(!p.may_send(), "a fourth would not");
+    }
+
+    #[test]
+    fn a_fast_link_keeps_several_frames_in_flight_and_full_colour() {
         let t0 = Instant::now();
         let mut p = Pacer::new(t0);
         p.answered(t0 + ms(1));
-        let mut t = t0 + ms(1);
-        for _ in 0..10 {
-            p.sent(t, 5000, true);
-            p.answered(t + Duration::from_micros(500));
-            p.answered(t + Duration::from_micros(800));
-            t += ms(33);
-            assert!(p.may_send(t - ms(32)));
-        }
+        // Until a frame has been timed, one at a time.
+        p.sent(t0 + ms(1), 5000, true);
+        assert!(!p.may_send());
+        p.answered(t0 + ms(2));
+        p.answered(t0 + ms(2));
         // A long round trip on a fast link: several frames in flight.
+        let mut t = t0 + ms(10);
         for i in 0..FAST_IN_FLIGHT {
-            assert!(p.may_send(t), "frame {i}");
+            assert!(p.may_send(), "frame {i}");
             p.sent(t, 5000, true);
             t += ms(33);
         }
-        assert!(!p.may_send(t));
-        assert!(!p.slow());
+        assert!(!p.may_send());
+        assert!(!p.slow() && !p.cheap());
         assert!(p.describe().contains("fast"), "{}", p.describe());
     }
 
@@ -346,13 +400,14 @@ mod tests {
         assert_eq!(p.mode(), Mode::Unpaced);
         assert!(!p.asks());
         // Unpaced: a frame once the writer has written the last one.
-        assert!(!p.may_send(t0 + ms(200)), "the probe is not written yet");
+        assert!(!p.may_send(), "the probe is not written yet");
         p.written();
-        assert!(p.may_send(t0 + ms(200)));
+        assert!(p.may_send());
         p.sent(t0 + ms(201), 5000, false);
-        assert!(!p.may_send(t0 + ms(210)));
+        assert!(!p.may_send());
+        assert!(p.may_send_update());
         p.written();
-        assert!(p.may_send(t0 + ms(210)));
+        assert!(p.may_send());
         // The probe's answer arrives late (a long round trip): paced now.
         p.answered(t0 + ms(350));
         assert_eq!(p.mode(), Mode::Paced);
@@ -371,6 +426,6 @@ mod tests {
         assert_eq!(p.mode(), Mode::Paced);
         p.tick(t0 + ms(11) + ANSWER_TIMEOUT);
         assert_eq!(p.mode(), Mode::Unpaced);
-        assert!(p.may_send(t0 + ms(11) + ANSWER_TIMEOUT));
+        assert!(p.may_send());
     }
 }

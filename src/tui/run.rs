@@ -310,8 +310,7 @@ impl FrameLoop {
     /// and a key's update at once (answer keys rather than wait for the
     /// next frame).
     fn present(&mut self) -> anyhow::Result<()> {
-        let now = Instant::now();
-        if self.dirty && self.pacer.may_send(now) {
+        if self.dirty && self.pacer.may_send() {
             self.draw(false)
         } else if self.update_wanted && self.pacer.may_send_update() {
             self.draw(true)
@@ -339,7 +338,12 @@ impl FrameLoop {
             snap,
             stats: &self.stats,
             report: &self.report,
-            palette: self.palette,
+            // On a slow link, colours cost about half the bytes of a frame.
+            palette: if self.pacer.cheap() {
+                Palette::Mono
+            } else {
+                self.palette
+            },
             aspect: self.aspect,
         };
         let raster = &mut self.raster;
