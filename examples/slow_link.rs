@@ -1,7 +1,7 @@
 //! Key-to-screen latency of the real binary over an emulated slow link
 //! (issue 16). Run `cargo build --release` first, then
 //! `cargo run --release --example slow_link -- [KEYS] [BIN] [ONLY]`
-//! (ONLY: run just the links whose name contains it).
+//! (ONLY: run just the links whose name contains it; NO_COLOR is passed on).
 //! Prints, per link, the median and worst latency of KEYS presses of `v`
 //! at random moments, the frames per second shown by the app, and the
 //! bytes per second and per frame the screen received.
@@ -39,7 +39,11 @@ fn main() {
         }
         let mut spec = Spec::new(rate, delay);
         spec.answers = answers;
-        let mut link = Link::start(CommandBuilder::new(&bin), spec);
+        let mut cmd = CommandBuilder::new(&bin);
+        if std::env::var_os("NO_COLOR").is_some() {
+            cmd.env("NO_COLOR", "1");
+        }
+        let mut link = Link::start(cmd, spec);
         let lat = style_key_latencies(
             &link,
             keys,

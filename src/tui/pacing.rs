@@ -26,7 +26,7 @@ const FAST: Duration = Duration::from_millis(3);
 /// Frames in flight on a fast link: a long round trip then does not cap
 /// the frame rate (30 fps over a 100 ms round trip needs three).
 const FAST_IN_FLIGHT: usize = 4;
-/// Below this rate frames drop their colours (about half the bytes): 30
+/// Below this rate frames drop their colours (docs/terminal-io.md): 30
 /// coloured frames a second take 130-180 KB/s at 120x40.
 const CHEAP_RATE: f64 = 100_000.0;
 /// On a slow link a second frame may follow the one in flight only if both

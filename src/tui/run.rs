@@ -338,7 +338,7 @@ impl FrameLoop {
             snap,
             stats: &self.stats,
             report: &self.report,
-            // On a slow link, colours cost about half the bytes of a frame.
+            // On a slow link, frames without colours are much smaller.
             palette: if self.pacer.cheap() {
                 Palette::Mono
             } else {

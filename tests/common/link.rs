@@ -71,7 +71,9 @@ impl Link {
             })
             .expect("openpty");
         cmd.env("TERM", "xterm-256color");
-        cmd.env_remove("NO_COLOR");
+        if cmd.get_env("NO_COLOR").is_none() {
+            cmd.env_remove("NO_COLOR");
+        }
         let child = pty.slave.spawn_command(cmd).expect("spawn");
         drop(pty.slave);
         let mut reader = pty.master.try_clone_reader().expect("reader");
