@@ -9,7 +9,7 @@ pub struct ThreadCpu {
     pub cpu_seconds: f64,
 }
 
-/// The fields of DESIGN.md's bench JSON, plus `capped_steps`,
+/// The fields of docs/design.md's bench JSON, plus `capped_steps`,
 /// `temperature` and `collisions_per_second`.
 #[derive(Debug, Serialize)]
 pub struct BenchReport {

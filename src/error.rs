@@ -1,4 +1,4 @@
-//! Bad input: one clear message, exit code 2 (DESIGN.md, Command line).
+//! Bad input: one clear message, exit code 2 (docs/design.md, Command line).
 use std::fmt;
 
 /// Something the user gave us is wrong; the message names what and where.

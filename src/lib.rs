@@ -6,6 +6,7 @@ pub mod cli;
 pub mod cpu;
 pub mod engine;
 pub mod error;
+pub mod memory;
 pub mod physics;
 pub mod scene;
 pub mod tradeoff;

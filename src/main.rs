@@ -2,12 +2,13 @@
 use ballpit::cli::{Cli, Command};
 use ballpit::error::BadInput;
 use ballpit::{bench, scene};
-use clap::Parser;
-use std::io::Write;
+use clap::CommandFactory;
+use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    // clap prints its own message and exits with 2 on a usage error (0 for --help).
+    let cli = Cli::try_parse_checked(std::env::args_os()).unwrap_or_else(|e| e.exit());
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -23,6 +24,14 @@ fn main() -> ExitCode {
     }
 }
 
+/// Write `bytes` to stdout; a full disk or a closed pipe is reported, not a panic.
+fn emit(bytes: &[u8]) -> Result<(), BadInput> {
+    let mut out = std::io::stdout().lock();
+    out.write_all(bytes)
+        .and_then(|()| out.flush())
+        .map_err(|e| BadInput(format!("cannot write to stdout: {e}")))
+}
+
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Bench(args)) => {
@@ -32,6 +41,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 .tick
                 .unwrap_or_else(|| args.steps.div_ceil(100).clamp(1, u64::from(u32::MAX)) as u32);
             let world = scene::build_world(&args.scene.spec())?;
+            fits(world.spheres.len(), Some(settings.model))?;
             let dump = args
                 .dump
                 .as_deref()
@@ -41,25 +51,47 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             if let Some(file) = dump {
                 file.write(&world)?;
             }
-            println!("{}", serde_json::to_string(&report)?);
-            Ok(())
+            let line = serde_json::to_string(&report)? + "\n";
+            Ok(emit(line.as_bytes())?)
         }
         Some(Command::Tradeoff(args)) => {
             let world = scene::build_world(&args.scene.spec())?;
             ballpit::tradeoff::run(world, args.out.as_deref())
         }
+        Some(Command::Completions { shell }) => {
+            let mut script = Vec::new();
+            clap_complete::generate(shell, &mut Cli::command(), "ballpit", &mut script);
+            Ok(emit(&script)?)
+        }
+        Some(Command::Man) => {
+            let mut page = Vec::new();
+            clap_mangen::Man::new(Cli::command()).render(&mut page)?;
+            Ok(emit(&page)?)
+        }
         None => {
+            // Flags, then the terminal, then the scene: nothing is built for
+            // a screen that cannot open.
             let settings = cli.run.settings()?;
+            let opts = cli.options();
+            if !(std::io::stdin().is_terminal() && std::io::stdout().is_terminal()) {
+                return Err(BadInput(
+                    "ballpit's screen needs a terminal, but stdin or stdout is not one; \
+                     for a headless run use `ballpit bench`"
+                        .into(),
+                )
+                .into());
+            }
             let world = scene::build_world(&cli.scene.spec())?;
-            let color = match cli.color.as_deref() {
-                None => ballpit::tui::ColorChoice::Auto,
-                Some(c) => c.parse().map_err(BadInput)?,
-            };
-            let opts = ballpit::tui::Options {
-                fps: cli.fps,
-                color,
-            };
+            // The app can switch to any model: plan for the hungriest.
+            fits(world.spheres.len(), None)?;
             ballpit::tui::run(world, settings, opts)
         }
     }
+}
+
+/// Refuse a world the machine has no memory for, before the model builds
+/// its structures.
+fn fits(count: usize, model: Option<ballpit::physics::ModelKind>) -> Result<(), BadInput> {
+    use ballpit::memory;
+    memory::check(count, model, memory::available()).map_err(BadInput)
 }

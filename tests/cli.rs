@@ -141,11 +141,11 @@ fn bad_input_exits_2_with_one_clear_message() {
         (vec!["--threads".into(), "0".into()], "--threads must be"),
         (
             vec!["--model".into(), "magic".into()],
-            "unknown model 'magic'",
+            "invalid value 'magic' for '--model <MODEL>'\n  [possible values: discrete, swept, exact]",
         ),
         (
             vec!["--threading".into(), "many".into()],
-            "unknown threading 'many'",
+            "[possible values: off, worker, pool, split]",
         ),
         (
             vec!["--scene".into(), "moon".into()],
@@ -269,4 +269,211 @@ fn bench_runs_every_threading_mode_to_the_same_bits() {
         "threading modes differ"
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn flags_before_a_subcommand_are_refused_not_dropped() {
+    for (args, flag, sub) in [
+        (
+            vec!["--model", "exact", "bench", "--steps", "2"],
+            "--model",
+            "bench",
+        ),
+        (vec!["--count", "10", "tradeoff"], "--count", "tradeoff"),
+        (
+            vec!["--fps", "10", "bench", "--steps", "1"],
+            "--fps",
+            "bench",
+        ),
+        (
+            vec!["--color", "16", "completions", "bash"],
+            "--color",
+            "completions",
+        ),
+    ] {
+        let out = ballpit().args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        let want = format!("{flag} must come after `{sub}`");
+        assert!(err.contains(&want), "{args:?}: got `{err}`");
+        assert!(out.stdout.is_empty(), "{args:?}");
+    }
+    // After the subcommand the same flag is honoured.
+    let v = json(&["--model", "exact", "--steps", "2", "--count", "20"]);
+    assert_eq!(v["model"], "exact");
+    assert_eq!(v["n"], 20);
+}
+
+#[test]
+fn clap_usage_errors_exit_2_and_help_exits_0() {
+    for args in [
+        vec!["--bogus"],
+        vec!["bench", "--steps"],
+        vec!["bench", "--steps", "1", "extra"],
+        vec!["--fps", "0"],
+        vec!["--fps", "2000"],
+        vec!["--fps", "1e-30"],
+        vec!["--dt", "1/x"],
+        vec!["--color", "mauve"],
+        vec!["completions", "tcsh"],
+        vec!["nonsense"],
+    ] {
+        let out = ballpit().args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.starts_with("error: "), "{args:?}: {err}");
+        assert!(out.stdout.is_empty(), "{args:?}");
+    }
+    let out = ballpit().args(["--fps", "0"]).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("must be above 0 and at most 1000"), "{err}");
+    for args in [vec!["--help"], vec!["bench", "--help"], vec!["--version"]] {
+        let out = ballpit().args(&args).output().unwrap();
+        assert_eq!(out.status.code(), Some(0), "{args:?}");
+        assert!(!out.stdout.is_empty(), "{args:?}");
+    }
+}
+
+#[test]
+fn dt_may_be_a_fraction() {
+    let v = json(&["--dt", "1/120", "--steps", "2", "--count", "20"]);
+    assert_eq!(v["dt"].as_f64(), Some(1.0 / 120.0));
+}
+
+#[test]
+fn help_lists_the_allowed_values_and_ranges() {
+    let help = |args: &[&str]| {
+        let out = ballpit().args(args).output().unwrap();
+        assert!(out.status.success(), "{args:?}");
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let top = help(&["--help"]);
+    for want in [
+        "discrete",
+        "swept",
+        "exact",
+        "off",
+        "worker",
+        "pool",
+        "split",
+        "256",
+        "true",
+        "0 < F <= 1000",
+        "1 to 256",
+        "0 to 10000000",
+        "[default: 1/60]",
+    ] {
+        assert!(top.contains(want), "ballpit --help lacks `{want}`");
+    }
+    for p in ballpit::scene::presets::PRESETS {
+        assert!(top.contains(p.name) && top.contains(p.about), "{}", p.name);
+    }
+    let bench = help(&["bench", "--help"]);
+    for (field, what) in ballpit::cli::BENCH_FIELDS {
+        assert!(bench.contains(field) && bench.contains(what), "{field}");
+    }
+    let tradeoff = help(&["tradeoff", "--help"]);
+    for want in ["1/1920", "tradeoff.csv", "tradeoff.svg", "pos_err_rms"] {
+        assert!(tradeoff.contains(want), "tradeoff --help lacks `{want}`");
+    }
+}
+
+#[test]
+fn bench_help_names_exactly_the_fields_the_json_has() {
+    let out = ballpit()
+        .args(["bench", "--steps", "2", "--count", "20"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    // Keep the printed order: a JSON object's keys in the line as written.
+    let line = String::from_utf8(out.stdout).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&line).unwrap();
+    let mut keys: Vec<(usize, &str)> = v
+        .as_object()
+        .unwrap()
+        .keys()
+        .map(|k| (line.find(&format!("\"{k}\":")).unwrap(), k.as_str()))
+        .collect();
+    keys.sort();
+    let printed: Vec<&str> = keys.into_iter().map(|(_, k)| k).collect();
+    let documented: Vec<&str> = ballpit::cli::BENCH_FIELDS.iter().map(|f| f.0).collect();
+    assert_eq!(printed, documented, "bench --help and the JSON disagree");
+}
+
+#[test]
+fn completions_and_man_page_come_from_the_cli() {
+    // elvish and powershell complete flags but not their values.
+    for (shell, values) in [
+        ("bash", true),
+        ("zsh", true),
+        ("fish", true),
+        ("elvish", false),
+        ("powershell", false),
+    ] {
+        let out = ballpit().args(["completions", shell]).output().unwrap();
+        assert!(out.status.success(), "{shell}");
+        let script = String::from_utf8(out.stdout).unwrap();
+        let mut wants = vec!["ballpit", "threading", "tradeoff"];
+        if values {
+            wants.push("exact");
+        }
+        for want in wants {
+            assert!(script.contains(want), "{shell}: no `{want}`");
+        }
+    }
+    let out = ballpit().arg("man").output().unwrap();
+    assert!(out.status.success());
+    let page = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        page.starts_with(".ie") && page.contains(".TH ballpit 1"),
+        "{page}"
+    );
+    for want in ["\\-\\-model", "bench", "tradeoff", "completions"] {
+        assert!(page.contains(want), "man page lacks `{want}`");
+    }
+}
+
+#[test]
+fn output_that_cannot_be_written_is_reported_not_a_panic() {
+    let bin = assert_cmd::cargo::cargo_bin("ballpit");
+    let full = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .unwrap();
+    let out = std::process::Command::new(&bin)
+        .args(["bench", "--steps", "2", "--count", "20"])
+        .stdout(full)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("cannot write to stdout"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    // A reader that went away: the pipe is closed before anything is written.
+    let mut child = std::process::Command::new(&bin)
+        .args(["bench", "--steps", "30", "--count", "2000"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("cannot write to stdout"), "{err}");
+}
+
+#[test]
+fn without_a_terminal_nothing_is_built_first() {
+    // This scene would take minutes and gigabytes to place; the app must say
+    // it needs a terminal before building it.
+    let out = ballpit()
+        .args(["--scene", "dense", "--count", "10", "--radius", "0.0001"])
+        .write_stdin("")
+        .timeout(std::time::Duration::from_secs(10))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("needs a terminal"), "{err}");
 }

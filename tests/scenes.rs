@@ -115,7 +115,7 @@ fn csv_errors_name_the_line() {
         ("0.95,0.5,0.5,0,0,0,0.1,1\n", "line 2: sphere at"),
         (
             "0.5,0.5,0.5,0,0,0,0.1,1\n0.6,0.5,0.5,0,0,0,0.1,1\n",
-            "line 2 and t.csv line 3 overlap",
+            "t.csv: line 2 and line 3 overlap",
         ),
         ("0.5,0.5,0.5,0,0,0,0.1\n", "line 2"),
     ];

@@ -25,7 +25,7 @@ fn without_a_tty_it_suggests_bench_and_exits_2() {
 
 #[test]
 fn a_bad_fps_or_colour_is_bad_input() {
-    for (flag, value, says) in [("--fps", "0", "--fps"), ("--color", "99", "colour")] {
+    for (flag, value, says) in [("--fps", "0", "--fps"), ("--color", "99", "--color")] {
         let out = Command::cargo_bin("ballpit")
             .unwrap()
             .args([flag, value])

@@ -30,7 +30,7 @@ use std::str::FromStr;
 use std::sync::Arc;
 use worker::Worker;
 
-/// Where the physics runs (DESIGN.md, Threading).
+/// Where the physics runs (docs/design.md, Threading).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Threading {
     Off,
@@ -108,9 +108,9 @@ pub enum Command {
     /// New spheres (median radius, rms speed, random directions) go into
     /// free space; removal drops the last ones.
     SetCount(usize),
-    /// Scale every radius so the largest becomes this (mass follows, same
-    /// density). Growth stops where spheres would touch; the snapshot's
-    /// notice says so.
+    /// Scale every radius so the largest becomes this; growing pushes the
+    /// spheres apart (masses, velocities and energy unchanged). When the box
+    /// is full, the snapshot's notice says so.
     SetRadius(f64),
     /// Back to the scene as it started.
     Reset,
@@ -324,6 +324,12 @@ impl Engine {
                     frame.model = m.build();
                 }
                 Command::SetCount(n) => {
+                    // Any model may run next: plan for the hungriest.
+                    let fits = crate::memory::check(n, None, crate::memory::available());
+                    if let (true, Err(e)) = (n > frame.world.spheres.len(), fits) {
+                        frame.notice = Some(format!("count limit: {e}"));
+                        continue;
+                    }
                     let w = &mut frame.world;
                     let radius = edit::typical_radius(w)
                         .or_else(|| edit::typical_radius(&self.initial))

@@ -1,4 +1,4 @@
-//! Time of impact and elastic response: the forms DESIGN.md fixes.
+//! Time of impact and elastic response: the forms docs/design.md fixes.
 use super::sphere::Sphere;
 use glam::DVec3;
 

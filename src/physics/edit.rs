@@ -1,9 +1,8 @@
 //! Changing the spheres between frames (the count and radius keys) without
 //! breaking what the models promise: new spheres go only into free space,
-//! radii grow only until two spheres (or a sphere and a wall) would touch.
+//! growing radii push the spheres apart, never into each other or a wall.
 //! The caller must `invalidate` the model afterwards.
-use super::broad::Grid;
-use super::exec::Serial;
+use super::relax;
 use super::sphere::Sphere;
 use super::world::World;
 use glam::DVec3;
@@ -13,9 +12,6 @@ use std::collections::HashMap;
 
 /// Random positions tried for one new sphere before the space counts as full.
 const TRIES: usize = 1000;
-/// Growth stops this far (relative) short of contact, so rounding cannot
-/// turn a touch into an overlap.
-const MARGIN: f64 = 1e-9;
 
 /// The median radius (`None` for an empty world).
 pub fn typical_radius(world: &World) -> Option<f64> {
@@ -189,83 +185,62 @@ impl FreeSpace {
     }
 }
 
-/// Scale every radius so the largest one becomes `target` (mass follows, at
-/// the same density; a uniform scene simply gets radius `target`). Growth stops short of the first contact a sphere would
-/// make with another or with a wall, and the returned notice says so.
-/// Spheres that already overlap (the `discrete` model allows it) are left to
-/// the model and do not hold the others back.
+/// Scale every radius so the largest one becomes `target` (a uniform scene
+/// simply gets radius `target`). Growing pushes spheres apart where they
+/// would overlap (see [`relax`]); each sphere keeps its mass and velocity, so
+/// energy and momentum are unchanged. When the box cannot hold the spheres at
+/// `target`, they grow as far as the packing allows and the returned notice
+/// says so.
 pub fn set_radius(world: &mut World, target: f64) -> Option<String> {
     let largest = world.spheres.iter().map(|s| s.radius).reduce(f64::max)?;
     if !target.is_finite() || target <= 0.0 {
         return Some(format!("radius must be a positive number, not {target}"));
     }
     let want = target / largest;
-    let mut factor = want;
-    let mut notice = None;
-    if want > 1.0 {
-        let (limit, what) = growth_limit(world, want);
-        if limit < want {
-            factor = (limit * (1.0 - MARGIN)).max(1.0);
-            notice = Some(format!(
-                "radius limit: {what} at r = {:.4}",
-                largest * factor
-            ));
-        }
-    }
-    if factor != 1.0 {
-        let f3 = factor * factor * factor;
+    if want <= 1.0 {
+        // Shrinking opens gaps and never makes an overlap.
         for s in &mut world.spheres {
-            s.radius *= factor;
-            s.mass *= f3;
+            s.radius *= want;
         }
+        return None;
     }
-    notice
+    let size = world.size;
+    let filled = relax::packing(&world.spheres, size);
+    let cap = (relax::MAX_PACKING / filled).cbrt();
+    let first = want.min(cap);
+    let (factor, spheres) = match relax::grown(&world.spheres, size, first) {
+        Some(s) => (first, Some(s)),
+        None => largest_fit(&world.spheres, size, first),
+    };
+    if let Some(s) = spheres {
+        world.spheres = s;
+    }
+    (factor < want).then(|| {
+        format!(
+            "radius limit: no room to grow further at r = {:.4} (packing {:.2})",
+            largest * factor,
+            relax::packing(&world.spheres, size)
+        )
+    })
 }
 
-/// The largest factor (up to `want`) all radii can grow by before something
-/// touches, and what touches first.
-fn growth_limit(world: &World, want: f64) -> (f64, &'static str) {
-    let size = world.size;
-    let wall = world
-        .spheres
-        .iter()
-        .map(|s| {
-            let gap = s.pos.min(DVec3::splat(size) - s.pos).min_element();
-            if gap >= s.radius {
-                gap / s.radius
-            } else {
-                f64::INFINITY
+/// Bisection steps between no growth and a factor that did not fit.
+const FIT_STEPS: usize = 4;
+
+/// The largest factor below `too_big` found to fit, with the grown spheres
+/// (1 and `None` when not even a little growth fits).
+fn largest_fit(spheres: &[Sphere], size: f64, too_big: f64) -> (f64, Option<Vec<Sphere>>) {
+    let (mut lo, mut hi) = (1.0, too_big);
+    let mut best = None;
+    for _ in 0..FIT_STEPS {
+        let mid = 0.5 * (lo + hi);
+        match relax::grown(spheres, size, mid) {
+            Some(s) => {
+                lo = mid;
+                best = Some(s);
             }
-        })
-        .fold(f64::INFINITY, f64::min);
-    let mut best = (want, "");
-    if wall < best.0 {
-        best = (wall, "a sphere touches a wall");
-    }
-    // Search outwards by doubling, so a huge request over many spheres never
-    // asks the grid for all pairs at once: at each reach the spheres are at
-    // most twice as crowded as where the previous round found no contact.
-    let mut grid = Grid::default();
-    let mut pairs = Vec::new();
-    let mut reach = 1.0f64;
-    loop {
-        reach = (reach * 2.0).min(best.0);
-        grid.build(&world.spheres, size, |s| (s.pos, s.radius * reach), &Serial);
-        grid.pairs(&Serial, &|_: u32, _: u32| true, &mut pairs);
-        let mut touch = f64::INFINITY;
-        for &(i, j) in &pairs {
-            let (a, b) = (&world.spheres[i as usize], &world.spheres[j as usize]);
-            let sum = a.radius + b.radius;
-            let d = a.pos.distance(b.pos);
-            if d >= sum {
-                touch = touch.min(d / sum);
-            }
-        }
-        if touch < best.0 {
-            best = (touch, "spheres touch");
-        }
-        if touch <= reach || reach >= best.0 {
-            return best;
+            None => hi = mid,
         }
     }
+    (lo, best)
 }

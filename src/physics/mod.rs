@@ -9,6 +9,7 @@ pub mod exact;
 pub mod exec;
 pub mod flight;
 pub mod model;
+pub mod relax;
 pub mod sphere;
 pub mod swept;
 pub mod world;

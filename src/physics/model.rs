@@ -3,7 +3,7 @@ use super::world::World;
 use std::fmt;
 use std::str::FromStr;
 
-/// The collision models of DESIGN.md.
+/// The collision models of docs/design.md.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ModelKind {
     Discrete,

@@ -11,7 +11,7 @@ pub struct Sphere {
 }
 
 impl Sphere {
-    /// A sphere of density 1 (mass = volume), as DESIGN.md defaults it.
+    /// A sphere of density 1 (mass = volume), as docs/design.md defaults it.
     pub fn new(pos: DVec3, vel: DVec3, radius: f64) -> Self {
         Sphere {
             pos,

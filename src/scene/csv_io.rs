@@ -12,9 +12,9 @@ use std::path::Path;
 pub const HEADER: [&str; 8] = ["x", "y", "z", "vx", "vy", "vz", "radius", "mass"];
 
 pub fn read(path: &Path, size: f64) -> Result<World, BadInput> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| bad_input!("cannot read scene file {}: {e}", path.display()))?;
-    parse(&text, size, &path.display().to_string())
+    let name = path.display().to_string();
+    let text = super::read_text(path)?;
+    parse(&text, size, &name)
 }
 
 /// Parse CSV text; `name` prefixes every message (`file.csv line 7: ...`).
@@ -36,12 +36,22 @@ pub fn parse(text: &str, size: f64, name: &str) -> Result<World, BadInput> {
     }
     let mut spheres = Vec::new();
     let mut lines = Vec::new();
+    // Lines counted from the bytes, not by the reader, so CRLF files count
+    // like LF ones (a record's position may be the `\n` ending the last).
+    let line_at = |byte: u64| {
+        let start = byte as usize;
+        let skip = text.as_bytes()[start.min(text.len())..]
+            .iter()
+            .take_while(|&&b| b == b'\r' || b == b'\n')
+            .count();
+        super::line_of(text, start + skip)
+    };
     for rec in rdr.records() {
         let rec = rec.map_err(|e| {
-            let line = e.position().map_or(0, |p| p.line());
+            let line = e.position().map_or(0, |p| line_at(p.byte()));
             bad_input!("{name} line {line}: {e}")
         })?;
-        let line = rec.position().map_or(0, |p| p.line());
+        let line = rec.position().map_or(0, |p| line_at(p.byte()));
         if rec.len() != 8 {
             return bad!("{name} line {line}: expected 8 fields, found {}", rec.len());
         }
@@ -63,7 +73,7 @@ pub fn parse(text: &str, size: f64, name: &str) -> Result<World, BadInput> {
         lines.push(line);
     }
     let world = World::new(size, spheres);
-    check(&world, &|i| format!("{name} line {}", lines[i]))?;
+    check(&world, name, &|i| format!("line {}", lines[i]))?;
     Ok(world)
 }
 

@@ -5,10 +5,10 @@ pub mod place;
 pub mod presets;
 pub mod toml_file;
 
-use crate::bad;
 use crate::error::BadInput;
 use crate::physics::sphere::volume;
 use crate::physics::{Sphere, World};
+use crate::{bad, bad_input};
 use glam::DVec3;
 use std::path::Path;
 
@@ -29,10 +29,56 @@ pub struct SceneSpec {
 
 pub const DEFAULT_SEED: u64 = 1;
 
+/// Lengths (the box, a radius) ballpit accepts: volumes, energies and the
+/// fourth powers in a time of impact stay normal `f64` numbers in between.
+pub const LENGTH_RANGE: (f64, f64) = (1e-40, 1e40);
+/// Smallest radius, in box lengths: below it a contact is finer than the
+/// rounding of a position in the box.
+pub const MIN_RADIUS_REL: f64 = 1e-12;
+
+/// Where a scene value came from, for messages that blame what the user
+/// actually gave: a flag, a key of a scene file, or the preset.
+struct Source<'a> {
+    flag: &'static str,
+    file: Option<&'a str>,
+}
+
+impl Source<'_> {
+    /// `--radius`, `scene.toml: radius`, or `the preset's radius`.
+    fn label(&self, given_as_flag: bool, in_file: bool) -> String {
+        let key = self.flag.trim_start_matches("--");
+        match (given_as_flag, in_file, self.file) {
+            (true, _, _) => self.flag.to_string(),
+            (false, true, Some(f)) => format!("{f}: {key}"),
+            _ => format!("the preset's {key}"),
+        }
+    }
+}
+
+/// The text of a scene file, or a message saying where it is not UTF-8.
+pub(crate) fn read_text(path: &Path) -> Result<String, BadInput> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| bad_input!("cannot read scene file {}: {e}", path.display()))?;
+    String::from_utf8(bytes).or_else(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let line = e.as_bytes()[..at].iter().filter(|&&b| b == b'\n').count() + 1;
+        bad!("{} line {line}: not UTF-8 text", path.display())
+    })
+}
+
+/// The 1-based line holding byte `at` of `text`.
+pub(crate) fn line_of(text: &str, at: usize) -> usize {
+    text.as_bytes()[..at.min(text.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
+}
+
 /// Build the world a spec describes, or say what is wrong with it.
 pub fn build_world(spec: &SceneSpec) -> Result<World, BadInput> {
     if let Some(size) = spec.size {
-        positive("--box", size)?;
+        length("--box", size)?;
     }
     let scene = spec.scene.as_deref().unwrap_or("gas");
     if scene.ends_with(".csv") {
@@ -41,7 +87,7 @@ pub fn build_world(spec: &SceneSpec) -> Result<World, BadInput> {
         }
         return csv_io::read(Path::new(scene), spec.size.unwrap_or(1.0));
     }
-    let (file, spec) = if scene.ends_with(".toml") {
+    let (file, merged) = if scene.ends_with(".toml") {
         let f = toml_file::read(Path::new(scene))?;
         let merged = SceneSpec {
             scene: f.preset.clone(),
@@ -55,9 +101,23 @@ pub fn build_world(spec: &SceneSpec) -> Result<World, BadInput> {
     } else {
         (None, spec.clone())
     };
+    let file_name = file.as_ref().map(|(n, _)| n.as_str());
+    let from_file = |flag: &'static str, given: bool, in_file: bool| {
+        Source {
+            flag,
+            file: file_name,
+        }
+        .label(given, in_file)
+    };
+    let f = file.as_ref().map(|(_, f)| f);
+    let box_label = from_file(
+        "--box",
+        spec.size.is_some(),
+        f.is_some_and(|f| f.size.is_some()),
+    );
+    let size = merged.size.unwrap_or(1.0);
+    length(&box_label, size)?;
     if let Some((name, f)) = file.as_ref().filter(|(_, f)| !f.sphere.is_empty()) {
-        let size = spec.size.unwrap_or(1.0);
-        positive(&format!("{name}: box"), size)?;
         let spheres = f
             .sphere
             .iter()
@@ -71,49 +131,86 @@ pub fn build_world(spec: &SceneSpec) -> Result<World, BadInput> {
             })
             .collect();
         let world = World::new(size, spheres);
-        place::check(&world, &|i| format!("{name}: sphere {}", i + 1))?;
+        place::check(&world, name, &|i| format!("sphere {}", i + 1))?;
         return Ok(world);
     }
-    let name = spec.scene.as_deref().unwrap_or("gas");
+    let name = merged.scene.as_deref().unwrap_or("gas");
     let Some(preset) = presets::find(name) else {
         return bad!(
             "unknown scene '{name}' (expected a preset — {} — or a .toml/.csv file)",
             presets::names()
         );
     };
-    let size = spec.size.unwrap_or(1.0);
-    positive("--box", size)?;
-    let count = spec.count.unwrap_or(preset.count);
+    let count_label = from_file(
+        "--count",
+        spec.count.is_some(),
+        f.is_some_and(|f| f.count.is_some()),
+    );
+    let radius_label = from_file(
+        "--radius",
+        spec.radius.is_some(),
+        f.is_some_and(|f| f.radius.is_some()),
+    );
+    let speed_label = from_file(
+        "--speed",
+        spec.speed.is_some(),
+        f.is_some_and(|f| f.speed.is_some()),
+    );
+    let count = merged.count.unwrap_or(preset.count);
     if count > MAX_COUNT {
-        return bad!("--count {count} is more than the {MAX_COUNT} spheres ballpit supports");
+        return bad!("{count_label} {count} is more than the {MAX_COUNT} spheres ballpit supports");
     }
-    let radius = match (spec.radius, preset.packing) {
+    let radius = match (merged.radius, preset.packing) {
         (Some(r), _) => r,
         (None, Some(phi)) if count > 0 => {
             (phi * size.powi(3) / (count as f64 * volume(1.0))).cbrt()
         }
         (None, _) => preset.radius * size,
     };
-    positive("--radius", radius)?;
+    length(&radius_label, radius)?;
     if 2.0 * radius >= size {
         return bad!(
-            "--radius {radius} is too big for a box of {size} (it must be under {})",
+            "{radius_label} {radius} is too big for a box of {size} (it must be under {})",
             size / 2.0
         );
     }
-    let speed = spec.speed.unwrap_or(preset.speed * size);
-    if !speed.is_finite() || speed < 0.0 {
-        return bad!("--speed must be a finite number >= 0, got {speed}");
+    if radius < MIN_RADIUS_REL * size {
+        return bad!(
+            "{radius_label} {radius} is too small for a box of {size} (at least {:e}: a finer contact is lost in the rounding of positions)",
+            MIN_RADIUS_REL * size
+        );
     }
-    let mut rng = place::rng(spec.seed.unwrap_or(DEFAULT_SEED));
+    let speed = merged.speed.unwrap_or(preset.speed * size);
+    if !speed.is_finite() || speed < 0.0 {
+        return bad!("{speed_label} must be a finite number >= 0, got {speed}");
+    }
+    let mut rng = place::rng(merged.seed.unwrap_or(DEFAULT_SEED));
     let world = place::generate(preset, count, radius, speed, size, &mut rng)?;
     if !(world.spheres.iter().all(place::speed_ok) && world.kinetic_energy().is_finite()) {
         return bad!(
-            "--speed {speed:e} is too large: the spheres' energies or relative speeds squared would not be finite numbers"
+            "{speed_label} {speed:e} is too large: the spheres' energies or relative speeds squared would not be finite numbers"
         );
     }
-    place::check(&world, &|i| format!("generated sphere {i}"))?;
+    if speed > 0.0 && count > 0 && !world.kinetic_energy().is_normal() {
+        return bad!(
+            "{speed_label} {speed:e} is too small for spheres of radius {radius:e}: their kinetic energies underflow to 0, so energy figures would mean nothing"
+        );
+    }
+    place::check(&world, "generated scene", &|i| format!("sphere {i}"))?;
     Ok(world)
+}
+
+/// A box or radius: finite, positive, and within [`LENGTH_RANGE`].
+fn length(what: &str, x: f64) -> Result<(), BadInput> {
+    positive(what, x)?;
+    let (lo, hi) = LENGTH_RANGE;
+    if (lo..=hi).contains(&x) {
+        Ok(())
+    } else {
+        bad!(
+            "{what} {x:e} is outside {lo:e}..{hi:e}: volumes, energies and times of impact would overflow or underflow"
+        )
+    }
 }
 
 fn positive(what: &str, x: f64) -> Result<(), BadInput> {

@@ -126,7 +126,9 @@ fn random(radii: &[f64], size: f64, rng: &mut SceneRng) -> Option<Vec<(DVec3, f6
     if 2.0 * rmax >= size {
         return None;
     }
-    let cell = 2.0 * rmax;
+    // At least 1/2^20 of the box, so a cell index never saturates (all
+    // spheres in one cell would make placement quadratic).
+    let cell = (2.0 * rmax).max(size / f64::from(1u32 << 20));
     let key = |p: DVec3| (p / cell).floor().as_ivec3().to_array();
     let mut grid: HashMap<[i32; 3], Vec<usize>> = HashMap::new();
     let mut out: Vec<(DVec3, f64)> = Vec::with_capacity(radii.len());
@@ -174,7 +176,8 @@ fn lattice(radii: &[f64], size: f64, rng: &mut SceneRng) -> Result<Vec<(DVec3, f
         return Ok(Vec::new());
     }
     let rmax = radii.iter().copied().fold(0.0, f64::max);
-    let per_side = (size / (2.0 * rmax)).floor() as usize;
+    // Capped so the sites can be counted in a usize.
+    let per_side = (size / (2.0 * rmax)).floor().min(f64::from(1u32 << 20)) as usize;
     if per_side == 0 || per_side.saturating_pow(3) < n {
         let fraction: f64 = radii.iter().map(|&r| volume(r)).sum::<f64>() / size.powi(3);
         return bad!(
@@ -183,8 +186,7 @@ fn lattice(radii: &[f64], size: f64, rng: &mut SceneRng) -> Result<Vec<(DVec3, f
         );
     }
     let pitch = size / per_side as f64;
-    let mut sites: Vec<usize> = (0..per_side.pow(3)).collect();
-    sites.shuffle(rng);
+    let sites = pick_sites(per_side, n, rng);
     Ok(radii
         .iter()
         .zip(sites)
@@ -209,10 +211,26 @@ fn lattice(radii: &[f64], size: f64, rng: &mut SceneRng) -> Result<Vec<(DVec3, f
         .collect())
 }
 
+/// `n` distinct sites of a `per_side`^3 lattice in random order. A lattice
+/// far larger than `n` is sampled, never listed whole.
+fn pick_sites(per_side: usize, n: usize, rng: &mut SceneRng) -> Vec<usize> {
+    let total = per_side.pow(3);
+    if total <= 8 * n {
+        let mut sites: Vec<usize> = (0..total).collect();
+        sites.shuffle(rng);
+        sites.truncate(n);
+        sites
+    } else {
+        rand::seq::index::sample(rng, total, n).into_vec()
+    }
+}
+
 /// Why a world is not a valid scene, if it isn't: centres outside the cube,
-/// overlaps, non-finite or non-positive values. `what(i)` names sphere `i`
-/// in the message (e.g. its CSV line).
-pub fn check(world: &World, what: &dyn Fn(usize) -> String) -> Result<(), BadInput> {
+/// overlaps, non-finite or non-positive values. `source` names the file (or
+/// what made the scene) once; `item(i)` names sphere `i` in it (e.g. its CSV
+/// line).
+pub fn check(world: &World, source: &str, item: &dyn Fn(usize) -> String) -> Result<(), BadInput> {
+    let what = |i: usize| format!("{source} {}", item(i));
     let size = world.size;
     let tol = 1e-9 * size;
     for (i, s) in world.spheres.iter().enumerate() {
@@ -232,7 +250,7 @@ pub fn check(world: &World, what: &dyn Fn(usize) -> String) -> Result<(), BadInp
         if s.mass <= 0.0 {
             return bad!("{}: mass must be positive, got {}", what(i), s.mass);
         }
-        if 2.0 * s.radius > size {
+        if 2.0 * s.radius >= size {
             return bad!(
                 "{}: radius {} does not fit in a box of {size}",
                 what(i),
@@ -260,7 +278,7 @@ pub fn check(world: &World, what: &dyn Fn(usize) -> String) -> Result<(), BadInp
         }
     });
     if let Some((i, j, depth)) = first {
-        return bad!("{} and {} overlap by {depth}", what(i), what(j));
+        return bad!("{source}: {} and {} overlap by {depth}", item(i), item(j));
     }
     if !world.kinetic_energy().is_finite() {
         return bad!(

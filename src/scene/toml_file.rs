@@ -13,8 +13,8 @@
 //! radius = 0.05
 //! mass = 1.0              # optional, default: volume (density 1)
 //! ```
+use crate::bad;
 use crate::error::BadInput;
-use crate::{bad, bad_input};
 use serde::Deserialize;
 use std::path::Path;
 
@@ -35,24 +35,40 @@ pub struct SceneFile {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SphereEntry {
+    #[serde(deserialize_with = "three")]
     pub pos: [f64; 3],
-    #[serde(default)]
+    #[serde(default, deserialize_with = "three")]
     pub vel: [f64; 3],
     pub radius: f64,
     pub mass: Option<f64>,
 }
 
+/// Exactly three numbers: serde's fixed arrays let TOML pass a longer list.
+fn three<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
+    let v: Vec<f64> = Vec::deserialize(d)?;
+    <[f64; 3]>::try_from(v.as_slice()).map_err(|_| {
+        serde::de::Error::custom(format!("expected 3 numbers [x, y, z], found {}", v.len()))
+    })
+}
+
 pub fn read(path: &Path) -> Result<SceneFile, BadInput> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| bad_input!("cannot read scene file {}: {e}", path.display()))?;
+    let text = super::read_text(path)?;
     parse(&text, &path.display().to_string())
 }
 
+/// Most `[[sphere]]` entries a TOML scene may hold: parsing TOML takes
+/// about 3 KB a sphere, a CSV under a tenth of that.
+pub const MAX_SPHERES: usize = 100_000;
+
 pub fn parse(text: &str, name: &str) -> Result<SceneFile, BadInput> {
+    let entries = text.matches("[[sphere]]").count();
+    if entries > MAX_SPHERES {
+        return bad!(
+            "{name}: {entries} [[sphere]] entries; a TOML scene holds at most {MAX_SPHERES} (parsing takes about 3 KB a sphere): give that many spheres as a CSV"
+        );
+    }
     toml::from_str(text).or_else(|e: toml::de::Error| {
-        let line = e
-            .span()
-            .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+        let line = e.span().map(|s| super::line_of(text, s.start));
         let msg = e.message().to_string();
         match line {
             Some(l) => bad!("{name} line {l}: {msg}"),

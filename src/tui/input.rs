@@ -1,4 +1,4 @@
-//! Keys to actions (DESIGN.md, Keys). Kept apart from the state so the state
+//! Keys to actions (docs/design.md, Keys). Kept apart from the state so the state
 //! can be tested without a terminal.
 use crossterm::event::{KeyCode, KeyEvent, KeyEventKind, KeyModifiers};
 

@@ -1,0 +1,82 @@
+//! Help text built from the code's own tables: the bench JSON fields and the
+//! presets.
+use crate::scene::presets::PRESETS;
+
+/// The fields of `bench`'s JSON line, in the order it prints them, with what
+/// each holds; `bench --help` shows them and a test holds them to the output.
+pub const BENCH_FIELDS: &[(&str, &str)] = &[
+    ("n", "spheres"),
+    ("steps", "steps run"),
+    ("dt", "step length, s"),
+    ("model", "collision model"),
+    ("threading", "threading mode"),
+    ("threads", "pool threads (--threads)"),
+    (
+        "physics_threads",
+        "the threads the physics ran on, driver first",
+    ),
+    ("wall_seconds", "wall time of the stepping only"),
+    ("steps_per_second", "steps / wall_seconds"),
+    ("sphere_steps_per_second", "n x steps / wall_seconds"),
+    ("energy_start", "kinetic energy at the start"),
+    ("energy_end", "kinetic energy at the end"),
+    (
+        "energy_drift_rel",
+        "|energy_end - energy_start| / energy_start",
+    ),
+    (
+        "max_energy_err_rel",
+        "worst relative energy error over the frames",
+    ),
+    (
+        "escaped",
+        "centres outside [r, L-r] by more than 1e-9 L, at the end",
+    ),
+    (
+        "max_overlap_rel",
+        "deepest pair overlap / smaller radius, at the end",
+    ),
+    ("sphere_collisions", "sphere-sphere collisions"),
+    ("wall_collisions", "sphere-wall collisions"),
+    (
+        "wall_pressure",
+        "momentum given to the walls / (simulated time x wall area)",
+    ),
+    (
+        "collisions_per_second",
+        "sphere_collisions per simulated second",
+    ),
+    ("temperature", "mean kinetic energy per sphere, 2/3 x E/n"),
+    (
+        "capped_steps",
+        "steps that hit the model's event cap and were finished coarsely",
+    ),
+    (
+        "thread_cpu",
+        "[{name, cpu_seconds}] for every thread of the process",
+    ),
+    ("peak_rss_bytes", "peak resident memory of the process"),
+];
+
+pub(super) fn bench_after_help() -> String {
+    let mut s = String::from("Prints one JSON line with these fields:\n");
+    let w = BENCH_FIELDS.iter().map(|f| f.0.len()).max().unwrap_or(0);
+    for (name, what) in BENCH_FIELDS {
+        s.push_str(&format!("  {name:<w$}  {what}\n"));
+    }
+    s.push_str("\nExample: ballpit bench --scene dense --model exact --threading pool --steps 600");
+    s
+}
+
+pub(super) fn scene_long_help() -> String {
+    let mut s = String::from(
+        "A preset, a .toml scene or a .csv of spheres (header x,y,z,vx,vy,vz,radius,mass) \
+         [default: gas]. --count, --radius, --speed, --seed and --box override a preset.\n\
+         Presets:",
+    );
+    let w = PRESETS.iter().map(|p| p.name.len()).max().unwrap_or(0);
+    for p in &PRESETS {
+        s.push_str(&format!("\n  {:<w$}  {}", p.name, p.about));
+    }
+    s
+}

@@ -1,0 +1,226 @@
+//! The command line of docs/design.md. clap stays in this module: the enums
+//! of `values.rs` mirror the domain's (models, threading modes, colours) so
+//! physics/ and engine/ never see clap.
+mod help;
+mod values;
+
+pub use help::BENCH_FIELDS;
+pub use values::{ColorArg, MAX_FPS, ModelArg, ThreadingArg};
+
+use crate::bad;
+use crate::engine::Settings;
+use crate::error::BadInput;
+use crate::scene::SceneSpec;
+use clap::parser::ValueSource;
+use clap::{ArgMatches, Args, CommandFactory, FromArgMatches, Parser, Subcommand};
+use help::{bench_after_help, scene_long_help};
+use std::ffi::OsString;
+use std::path::PathBuf;
+use values::{parse_fps, parse_seconds};
+
+#[derive(Debug, Parser)]
+#[command(
+    name = "ballpit",
+    version,
+    about = "Elastic spheres in a cube, on worker threads, drawn in your terminal",
+    after_help = "Without a subcommand, opens the terminal app (press ? in it for the keys).\n\
+                  Scene and run flags go after a subcommand: ballpit bench --model exact --steps 600.\n\
+                  Units are box lengths and seconds. Bad input exits with code 2.",
+    // `--dt -1` must reach the validators and their message, not read as a flag.
+    allow_negative_numbers = true
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Command>,
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// Frames per second to draw at most (0 < F <= 1000; keys f/F change it)
+    #[arg(long, default_value_t = 30.0, value_name = "F", value_parser = parse_fps)]
+    pub fps: f64,
+    /// Colours (NO_COLOR is honoured unless this is given)
+    #[arg(long, value_enum, default_value_t = ColorArg::Auto, value_name = "COLORS")]
+    pub color: ColorArg,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Run a scene headless and print one JSON line
+    #[command(allow_negative_numbers = true, after_help = bench_after_help())]
+    Bench(BenchArgs),
+    /// Measure speed against accuracy for every model over a ladder of dt
+    #[command(
+        allow_negative_numbers = true,
+        long_about = "Measure speed against accuracy for every model over a ladder of dt.\n\n\
+                      Runs discrete, swept and exact on one thread for dt = 1/15 s down to \
+                      1/1920 s (halving), each for 2 simulated seconds, and measures each run \
+                      against a reference run of the same scene: cost (wall seconds per \
+                      simulated second), worst energy error, deepest overlap, escapes, \
+                      collisions missed, and the position error at a short horizon. Prints a \
+                      markdown table; the table names its reference.",
+        after_help = "With --out DIR it also writes DIR/tradeoff.csv (columns: model, dt, steps, \
+                      wall_s_per_sim_s, sphere_steps_per_second, energy_err_rel, max_overlap_rel, \
+                      escaped, sphere_collisions, missed_rel, horizon_s, pos_err_rms, capped_steps) \
+                      and DIR/tradeoff.svg (position error against cost, one line per model)."
+    )]
+    Tradeoff(TradeoffArgs),
+    /// Print a shell completion script, e.g. ballpit completions bash
+    Completions {
+        /// The shell to complete for
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
+    /// Print the man page (roff), e.g. ballpit man | man -l -
+    Man,
+}
+
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// Steps to run (0 only builds the scene, e.g. to --dump it)
+    #[arg(long, value_name = "K")]
+    pub steps: u64,
+    /// Write the final state as a sphere CSV (reads back with --scene FILE.csv)
+    #[arg(long, value_name = "FILE.csv", value_hint = clap::ValueHint::FilePath)]
+    pub dump: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct TradeoffArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Write tradeoff.csv and tradeoff.svg into this directory
+    #[arg(long, value_name = "DIR", value_hint = clap::ValueHint::DirPath)]
+    pub out: Option<PathBuf>,
+}
+
+#[derive(Debug, Args, Clone, Default)]
+pub struct SceneArgs {
+    /// A preset, a .toml scene or a .csv of spheres [default: gas]
+    #[arg(long, value_name = "NAME|FILE", long_help = scene_long_help(),
+          value_hint = clap::ValueHint::FilePath)]
+    pub scene: Option<String>,
+    /// Number of spheres (0 to 10000000) [default: the preset's]
+    #[arg(long, value_name = "N")]
+    pub count: Option<usize>,
+    /// Sphere radius in box lengths (> 0, under half the box) [default: the preset's]
+    #[arg(long, value_name = "R")]
+    pub radius: Option<f64>,
+    /// Speed (rms) in box lengths per second (>= 0) [default: the preset's]
+    #[arg(long, value_name = "V")]
+    pub speed: Option<f64>,
+    /// Random seed of the scene [default: 1]
+    #[arg(long, value_name = "S")]
+    pub seed: Option<u64>,
+    /// Edge of the cube (> 0) [default: 1]
+    #[arg(long = "box", value_name = "L")]
+    pub size: Option<f64>,
+}
+
+#[derive(Debug, Args, Clone)]
+pub struct RunArgs {
+    /// Step length in seconds (> 0), a number or a fraction such as 1/120
+    #[arg(long, default_value = "1/60", value_name = "DT", value_parser = parse_seconds)]
+    pub dt: f64,
+    /// Steps per rendered frame (0 freezes) [default: 1]; for bench, steps
+    /// per engine frame [default: a hundredth of --steps]
+    #[arg(long, value_name = "N")]
+    pub tick: Option<u32>,
+    /// Collision model
+    #[arg(long, value_enum, default_value_t = ModelArg::Swept, value_name = "MODEL")]
+    pub model: ModelArg,
+    /// Where the physics runs
+    #[arg(long, value_enum, default_value_t = ThreadingArg::Off, value_name = "MODE")]
+    pub threading: ThreadingArg,
+    /// Pool threads (1 to 256) [default: available cores]
+    #[arg(long, value_name = "K")]
+    pub threads: Option<usize>,
+}
+impl Cli {
+    /// Parse `args` (the program name first), as `main` does. Flags given
+    /// before a subcommand belong to the terminal app, and clap would drop
+    /// them silently, so they are refused (a usage error, exit code 2).
+    pub fn try_parse_checked<I, T>(args: I) -> Result<Cli, clap::Error>
+    where
+        I: IntoIterator<Item = T>,
+        T: Into<OsString> + Clone,
+    {
+        let mut cmd = Cli::command();
+        let matches = cmd.try_get_matches_from_mut(args)?;
+        if let Some((sub, _)) = matches.subcommand() {
+            let early = flags_given(&cmd, &matches);
+            if let Some(first) = early.first() {
+                let msg = format!(
+                    "{} must come after `{sub}` (ballpit {sub} {first} ...): flags before a subcommand are the terminal app's",
+                    early.join(", ")
+                );
+                return Err(cmd.error(clap::error::ErrorKind::ArgumentConflict, msg));
+            }
+        }
+        Cli::from_arg_matches(&matches).map_err(|e| e.format(&mut cmd))
+    }
+
+    /// The validated screen options.
+    pub fn options(&self) -> crate::tui::Options {
+        crate::tui::Options {
+            fps: self.fps,
+            color: self.color.into(),
+        }
+    }
+}
+
+/// The long names of the top-level flags the user typed.
+fn flags_given(cmd: &clap::Command, m: &ArgMatches) -> Vec<String> {
+    cmd.get_arguments()
+        .filter(|a| m.value_source(a.get_id().as_str()) == Some(ValueSource::CommandLine))
+        .filter_map(|a| a.get_long().map(|l| format!("--{l}")))
+        .collect()
+}
+
+impl SceneArgs {
+    pub fn spec(&self) -> SceneSpec {
+        SceneSpec {
+            scene: self.scene.clone(),
+            count: self.count,
+            radius: self.radius,
+            speed: self.speed,
+            seed: self.seed,
+            size: self.size,
+        }
+    }
+}
+
+impl RunArgs {
+    pub fn settings(&self) -> Result<Settings, BadInput> {
+        if !(self.dt.is_finite() && self.dt > 0.0) {
+            return bad!("--dt must be a finite number > 0, got {}", self.dt);
+        }
+        let threads = match self.threads {
+            Some(0) => return bad!("--threads must be at least 1"),
+            Some(k) if k > 256 => return bad!("--threads {k} is more than the 256 ballpit allows"),
+            Some(k) => k,
+            None => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        };
+        Ok(Settings {
+            model: self.model.into(),
+            dt: self.dt,
+            tick: self.tick.unwrap_or(1),
+            threading: self.threading.into(),
+            threads,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_command_is_well_formed() {
+        Cli::command().debug_assert();
+    }
+}

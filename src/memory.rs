@@ -1,0 +1,116 @@
+//! How much memory a world will take, and whether the machine has it: a count
+//! that would not fit is refused up front with the figure, never left to the
+//! kernel's OOM killer.
+use crate::physics::ModelKind;
+
+/// Peak bytes a sphere costs while a model steps, with a quarter for margin
+/// (peak RSS at a million spheres; docs/benchmarks.md has the runs).
+pub fn sphere_bytes(model: ModelKind) -> u64 {
+    match model {
+        ModelKind::Discrete => 650,
+        ModelKind::Swept => 550,
+        ModelKind::Exact => 1500,
+    }
+}
+
+/// What the process takes before any sphere: code, threads, buffers.
+const BASE_BYTES: u64 = 64 << 20;
+
+/// The share of the memory the machine has free that a run may plan on.
+const SHARE: f64 = 0.5;
+
+/// Bytes a world of `count` spheres needs under `model`, or under whichever
+/// model needs most (`None`: the app can switch models at any time).
+pub fn need(count: usize, model: Option<ModelKind>) -> u64 {
+    let per = model.map_or_else(
+        || {
+            ModelKind::ALL
+                .map(sphere_bytes)
+                .into_iter()
+                .max()
+                .unwrap_or(0)
+        },
+        sphere_bytes,
+    );
+    BASE_BYTES.saturating_add((count as u64).saturating_mul(per))
+}
+
+/// `MemAvailable` of `/proc/meminfo`, or the address-space limit
+/// (`ulimit -v`) if that is lower, in bytes (`None` when neither is known).
+pub fn available() -> Option<u64> {
+    let free = std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|t| parse_meminfo(&t));
+    let limit = rustix::process::getrlimit(rustix::process::Resource::As).current;
+    match (free, limit) {
+        (Some(f), Some(l)) => Some(f.min(l)),
+        (f, l) => f.or(l),
+    }
+}
+
+/// The `MemAvailable:` line of a meminfo text, in bytes.
+pub fn parse_meminfo(text: &str) -> Option<u64> {
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb.saturating_mul(1024))
+}
+
+/// Whether `count` spheres fit in `budget` bytes free; the message says how
+/// much they would need.
+pub fn check(count: usize, model: Option<ModelKind>, free: Option<u64>) -> Result<(), String> {
+    let Some(free) = free else {
+        return Ok(());
+    };
+    let need = need(count, model);
+    let allowed = (free as f64 * SHARE) as u64;
+    if need <= allowed {
+        return Ok(());
+    }
+    Err(format!(
+        "{count} spheres would need about {} of memory{}, more than half of the {} available (free memory, or ulimit -v if lower)",
+        mib(need),
+        model.map_or(String::new(), |m| format!(" with {m}")),
+        mib(free)
+    ))
+}
+
+fn mib(bytes: u64) -> String {
+    if bytes >= 10 << 30 {
+        format!("{} GiB", bytes >> 30)
+    } else {
+        format!("{} MiB", bytes >> 20)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_mem_available() {
+        let text =
+            "MemTotal:       24576000 kB\nMemFree:         1000 kB\nMemAvailable:   23000000 kB\n";
+        assert_eq!(parse_meminfo(text), Some(23_000_000 * 1024));
+        assert_eq!(parse_meminfo("MemTotal: 5 kB\n"), None);
+    }
+
+    #[test]
+    fn refuses_what_exceeds_half_of_what_is_free() {
+        let free = Some(4u64 << 30);
+        assert!(check(1_000_000, Some(ModelKind::Swept), free).is_ok());
+        let err = check(10_000_000, Some(ModelKind::Exact), free).unwrap_err();
+        assert!(
+            err.starts_with("10000000 spheres would need about 14"),
+            "{err}"
+        );
+        assert!(
+            err.contains("with exact") && err.contains("4096 MiB"),
+            "{err}"
+        );
+        // Unknown model: the hungriest one counts.
+        assert_eq!(need(1000, None), need(1000, Some(ModelKind::Exact)));
+        // No figure from the system: nothing to check against.
+        assert!(check(usize::MAX, None, None).is_ok());
+        assert_eq!(need(usize::MAX, None), u64::MAX);
+    }
+}

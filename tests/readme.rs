@@ -1,0 +1,255 @@
+//! The README against the repository and the real command line: every
+//! relative link and every repository path it names exists, every command
+//! in its `sh` blocks parses with the real CLI and its flags and scene
+//! validate, and its TOML example is a scene ballpit reads.
+use ballpit::cli::{Cli, Command, SceneArgs};
+use ballpit::scene::{self, presets};
+use std::path::{Path, PathBuf};
+
+const README: &str = include_str!("../README.md");
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The bodies of the fenced blocks whose info string is `lang`.
+fn blocks(text: &str, lang: &str) -> Vec<String> {
+    enum State {
+        Outside,
+        Keep(String),
+        Skip,
+    }
+    let mut out = Vec::new();
+    let mut state = State::Outside;
+    for line in text.lines() {
+        if let Some(info) = line.strip_prefix("```") {
+            state = match state {
+                State::Outside if info.trim() == lang => State::Keep(String::new()),
+                State::Outside => State::Skip,
+                State::Keep(body) => {
+                    out.push(body);
+                    State::Outside
+                }
+                State::Skip => State::Outside,
+            };
+        } else if let State::Keep(body) = &mut state {
+            body.push_str(line);
+            body.push('\n');
+        }
+    }
+    out
+}
+
+#[test]
+fn blocks_finds_the_fenced_bodies() {
+    let text = "a\n```sh\nx 1\n```\n```text\ny\n```\n```sh\nz\n```\n";
+    assert_eq!(blocks(text, "sh"), vec!["x 1\n", "z\n"]);
+    assert_eq!(blocks(text, "text"), vec!["y\n"]);
+}
+
+#[test]
+fn every_link_and_path_the_readme_names_exists() {
+    let mut checked = 0;
+    // Markdown links: ](target)
+    for piece in README.split("](").skip(1) {
+        let target = piece.split(')').next().unwrap_or("");
+        let target = target.split('#').next().unwrap_or("");
+        if target.is_empty() || target.contains("://") {
+            continue;
+        }
+        assert!(
+            root().join(target).exists(),
+            "README links {target}, which is not there"
+        );
+        checked += 1;
+    }
+    // Repository paths in backticks: `docs/...`, `scripts/...`, ...
+    let dirs = [
+        "docs/",
+        "src/",
+        "tests/",
+        "scripts/",
+        "examples/",
+        "benches/",
+        "peers/",
+    ];
+    for (i, piece) in README.split('`').enumerate() {
+        if i % 2 == 1 && dirs.iter().any(|d| piece.starts_with(d)) {
+            assert!(
+                root().join(piece).exists(),
+                "README names {piece}, which is not there"
+            );
+            checked += 1;
+        }
+    }
+    assert!(
+        checked >= 8,
+        "only {checked} links found: is the parser still right?"
+    );
+}
+
+/// GitHub's anchor for a heading: lower case, punctuation dropped, spaces
+/// to hyphens.
+fn slug(heading: &str) -> String {
+    heading
+        .trim()
+        .to_lowercase()
+        .chars()
+        .filter(|c| c.is_alphanumeric() || *c == ' ' || *c == '-' || *c == '_')
+        .map(|c| if c == ' ' { '-' } else { c })
+        .collect()
+}
+
+#[test]
+fn slug_is_githubs() {
+    assert_eq!(
+        slug("Terminal: `cargo bench --bench frame`"),
+        "terminal-cargo-bench---bench-frame"
+    );
+    assert_eq!(slug("20× Rapier"), "20-rapier");
+    assert_eq!(slug("Parts (`parts.rs`)"), "parts-partsrs");
+}
+
+#[test]
+fn every_link_between_the_docs_lands() {
+    let mut files = vec![root().join("README.md")];
+    for e in std::fs::read_dir(root().join("docs")).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "md") {
+            files.push(p);
+        }
+    }
+    let mut checked = 0;
+    for file in &files {
+        let text = std::fs::read_to_string(file).unwrap();
+        for piece in text.split("](").skip(1) {
+            let link = piece.split(')').next().unwrap_or("");
+            if link.contains("://") || link.is_empty() {
+                continue;
+            }
+            let (path, anchor) = link.split_once('#').unwrap_or((link, ""));
+            let target = if path.is_empty() {
+                file.clone()
+            } else {
+                file.parent().unwrap().join(path)
+            };
+            assert!(target.exists(), "{}: {link} is not there", file.display());
+            if !anchor.is_empty() {
+                let body = std::fs::read_to_string(&target).unwrap();
+                let found = body
+                    .lines()
+                    .filter_map(|l| l.strip_prefix('#'))
+                    .any(|h| slug(h.trim_start_matches('#')) == anchor);
+                assert!(found, "{}: no heading #{anchor} in {path}", file.display());
+            }
+            checked += 1;
+        }
+    }
+    assert!(
+        checked >= 20,
+        "only {checked} links: is the parser still right?"
+    );
+}
+
+/// The arguments (program name first) a README line runs ballpit with, or
+/// `None` for the one other command it shows (`cargo test`).
+fn ballpit_args(line: &str) -> Option<Vec<String>> {
+    let words: Vec<String> = line.split_whitespace().map(String::from).collect();
+    let w: Vec<&str> = words.iter().map(String::as_str).collect();
+    match w.as_slice() {
+        ["ballpit", ..] => Some(words),
+        ["cargo", "run", "--release"] => Some(vec!["ballpit".into()]),
+        ["cargo", "run", "--release", "--", rest @ ..] => Some(
+            std::iter::once("ballpit".to_string())
+                .chain(rest.iter().map(|s| s.to_string()))
+                .collect(),
+        ),
+        ["cargo", "test", "--release"] => None,
+        _ => panic!("README shows a command this test does not know: `{line}`"),
+    }
+}
+
+/// Build the scene the flags describe, unless it is a file an earlier
+/// command dumps (then that dump must come first).
+fn check_scene(scene_args: &SceneArgs, dumped: &[PathBuf], line: &str) {
+    match scene_args.scene.as_deref() {
+        Some(f) if f.ends_with(".csv") || f.ends_with(".toml") => {
+            assert!(
+                dumped.contains(&PathBuf::from(f)),
+                "`{line}` reads {f}, which no command above it writes"
+            );
+        }
+        _ => {
+            if let Err(e) = scene::build_world(&scene_args.spec()) {
+                panic!("`{line}`: {e}");
+            }
+        }
+    }
+}
+
+#[test]
+fn every_command_the_readme_shows_parses_and_validates() {
+    let mut parsed = 0;
+    let mut dumped: Vec<PathBuf> = Vec::new();
+    for block in blocks(README, "sh") {
+        for line in block.lines() {
+            let line = line.split(" #").next().unwrap_or("").trim();
+            if line.is_empty() {
+                continue;
+            }
+            let Some(args) = ballpit_args(line) else {
+                continue;
+            };
+            let cli = match Cli::try_parse_checked(&args) {
+                Ok(c) => c,
+                Err(e) => panic!("`{line}` does not parse:\n{e}"),
+            };
+            match &cli.command {
+                None => {
+                    cli.run
+                        .settings()
+                        .unwrap_or_else(|e| panic!("`{line}`: {e}"));
+                    check_scene(&cli.scene, &dumped, line);
+                }
+                Some(Command::Bench(b)) => {
+                    b.run.settings().unwrap_or_else(|e| panic!("`{line}`: {e}"));
+                    check_scene(&b.scene, &dumped, line);
+                    dumped.extend(b.dump.iter().cloned());
+                }
+                Some(Command::Tradeoff(t)) => check_scene(&t.scene, &dumped, line),
+                Some(Command::Completions { .. }) | Some(Command::Man) => {}
+            }
+            parsed += 1;
+        }
+    }
+    assert!(
+        parsed >= 5,
+        "only {parsed} commands found: is the parser still right?"
+    );
+}
+
+#[test]
+fn the_readme_toml_example_is_a_scene() {
+    let examples = blocks(README, "toml");
+    assert!(!examples.is_empty(), "the README shows no TOML scene");
+    let dir = std::env::temp_dir().join(format!("ballpit-readme-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (i, text) in examples.iter().enumerate() {
+        let path = dir.join(format!("scene{i}.toml"));
+        std::fs::write(&path, text).unwrap();
+        let spec = scene::SceneSpec {
+            scene: Some(path.to_string_lossy().into_owned()),
+            ..Default::default()
+        };
+        let world = scene::build_world(&spec).unwrap_or_else(|e| panic!("{text}\n{e}"));
+        assert!(!world.spheres.is_empty());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn every_preset_is_named_in_the_readme() {
+    for p in presets::PRESETS {
+        assert!(README.contains(&format!("`{}`", p.name)), "{}", p.name);
+    }
+}
