@@ -29,6 +29,7 @@ fn main() {
         ("unlimited, 0 ms", None, 0, true),
         ("unlimited, 50 ms", None, 50, true),
         ("64 KB/s, 50 ms", Some(64_000.0), 50, true),
+        ("32 KB/s, 50 ms", Some(32_000.0), 50, true),
         ("16 KB/s, 50 ms", Some(16_000.0), 50, true),
         ("unlimited, no answers", None, 0, false),
     ];
