@@ -17,8 +17,12 @@ use std::time::{Duration, Instant};
 pub const QUERY: &[u8] = b"\x1b[5n";
 /// How long the start-up probe waits for an answer.
 pub const PROBE: Duration = Duration::from_millis(200);
-/// A frame unanswered this long means the terminal stopped answering.
+/// A frame unanswered this long, plus its crossing at [`SLOWEST_LINK`],
+/// means the terminal stopped answering.
 const ANSWER_TIMEOUT: Duration = Duration::from_secs(3);
+/// Bytes per second of the slowest link the timeout allows for (a first
+/// frame in colour, 10 KB, then has 13 s).
+const SLOWEST_LINK: f64 = 1000.0;
 /// Frames a key's update may be queued behind (a full one and one update).
 const MAX_IN_FLIGHT: usize = 2;
 /// Below this the link is treated as fast: no idle gap, no frozen canvas.
@@ -53,6 +57,13 @@ struct Sent {
     /// Sent while another question was unanswered: its round trip includes
     /// waiting behind that one.
     queued: bool,
+}
+
+impl Sent {
+    /// When its answer is overdue.
+    fn deadline(&self) -> Instant {
+        self.at + ANSWER_TIMEOUT + Duration::from_secs_f64(self.bytes as f64 / SLOWEST_LINK)
+    }
 }
 
 /// What the app knows of the link to the terminal.
@@ -219,12 +230,7 @@ impl Pacer {
                 self.mode = Mode::Unpaced;
                 self.in_flight.clear();
             }
-            Mode::Paced
-                if self
-                    .in_flight
-                    .front()
-                    .is_some_and(|s| now.saturating_duration_since(s.at) > ANSWER_TIMEOUT) =>
-            {
+            Mode::Paced if self.in_flight.front().is_some_and(|s| now > s.deadline()) => {
                 self.mode = Mode::Unpaced;
                 self.in_flight.clear();
             }
@@ -263,7 +269,7 @@ impl Pacer {
     pub fn next_change(&self) -> Option<Instant> {
         match self.mode {
             Mode::Probing => Some(self.probe_deadline),
-            Mode::Paced => self.in_flight.front().map(|s| s.at + ANSWER_TIMEOUT),
+            Mode::Paced => self.in_flight.front().map(Sent::deadline),
             Mode::Unpaced => None,
         }
     }
@@ -422,9 +428,10 @@ mod tests {
         p.sent(t0 + ms(10), 5000, true);
         p.answered(t0 + ms(10));
         p.written();
-        p.tick(t0 + ms(10) + ANSWER_TIMEOUT);
+        // 5000 bytes may take 5 s on the slowest link allowed for.
+        p.tick(t0 + ms(10) + ANSWER_TIMEOUT + ms(5000));
         assert_eq!(p.mode(), Mode::Paced);
-        p.tick(t0 + ms(11) + ANSWER_TIMEOUT);
+        p.tick(t0 + ms(11) + ANSWER_TIMEOUT + ms(5000));
         assert_eq!(p.mode(), Mode::Unpaced);
         assert!(p.may_send());
     }
