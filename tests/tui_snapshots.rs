@@ -48,6 +48,7 @@ fn stats() -> Stats {
         steps_per_second: 30.0,
         collisions_per_second: 12.0,
         detected: Some(Palette::True),
+        link: None,
     }
 }
 

@@ -3,8 +3,9 @@
 //! that goes away ends the process instead of leaving it spinning.
 use super::output::END_SYNC;
 use crossbeam_channel::Sender;
-use crossterm::event::{Event, KeyEvent};
+use crossterm::event::KeyEvent;
 use crossterm::{cursor, execute, terminal};
+use parking_lot::Mutex;
 use std::io::{self, Write};
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -15,6 +16,10 @@ use std::time::Duration;
 #[derive(Clone, Debug, PartialEq)]
 pub enum Msg {
     Key(KeyEvent),
+    /// The terminal answered a status request (read at that instant).
+    Status(std::time::Instant),
+    /// The `output` thread finished writing a chunk.
+    Written,
     Resize,
     /// A termination signal (its number).
     Signal(i32),
@@ -24,7 +29,91 @@ pub enum Msg {
     Panic,
 }
 
-static ACTIVE: AtomicBool = AtomicBool::new(false);
+/// The terminal's state: set up or restored, and the lock every write to it
+/// holds, so that nothing is written once `restore` has run.
+pub struct Latch {
+    active: AtomicBool,
+    writing: Mutex<()>,
+}
+
+/// How long `restore` waits for a write in progress (a frame going out over
+/// a slow link) before it writes anyway.
+const RESTORE_WAIT: Duration = Duration::from_millis(500);
+
+impl Latch {
+    pub const fn new() -> Latch {
+        Latch {
+            active: AtomicBool::new(false),
+            writing: Mutex::new(()),
+        }
+    }
+
+    fn open(&self) {
+        self.active.store(true, Ordering::SeqCst);
+    }
+
+    /// Closes the latch; `put_back` runs once, after any write in progress
+    /// has finished. Later writes through a [`Gated`] writer fail.
+    pub fn close(&self, put_back: impl FnOnce()) {
+        if self.active.swap(false, Ordering::SeqCst) {
+            let _lock = self.writing.try_lock_for(RESTORE_WAIT);
+            put_back();
+        }
+    }
+}
+
+impl Default for Latch {
+    fn default() -> Latch {
+        Latch::new()
+    }
+}
+
+/// A writer to the terminal that stops writing once the terminal has been
+/// restored (a frame must not land on the shell's screen after a panic).
+pub struct Gated<W: Write> {
+    inner: W,
+    latch: &'static Latch,
+}
+
+impl<W: Write> Gated<W> {
+    pub fn new(inner: W, latch: &'static Latch) -> Gated<W> {
+        Gated { inner, latch }
+    }
+}
+
+fn restored() -> io::Error {
+    io::Error::other("the terminal has been restored")
+}
+
+impl<W: Write> Write for Gated<W> {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        let _lock = self.latch.writing.lock();
+        if !self.latch.active.load(Ordering::SeqCst) {
+            return Err(restored());
+        }
+        self.inner.write(buf)
+    }
+    fn flush(&mut self) -> io::Result<()> {
+        let _lock = self.latch.writing.lock();
+        if !self.latch.active.load(Ordering::SeqCst) {
+            return Err(restored());
+        }
+        self.inner.flush()
+    }
+}
+
+/// The real terminal's latch.
+pub static TERMINAL: Latch = Latch::new();
+
+/// Stdout, gated by the terminal's latch: the only way frames go out.
+pub fn gated_stdout() -> Gated<io::Stdout> {
+    Gated::new(io::stdout(), &TERMINAL)
+}
+
+/// Pasted text arrives bracketed, so it is not taken for key presses.
+const PASTE_ON: &[u8] = b"\x1b[?2004h";
+const PASTE_OFF: &[u8] = b"\x1b[?2004l";
+
 static PANICKED: AtomicBool = AtomicBool::new(false);
 static WAKE: OnceLock<Sender<Msg>> = OnceLock::new();
 static HOOK: OnceLock<()> = OnceLock::new();
@@ -48,10 +137,13 @@ impl Guard {
             }));
         });
         terminal::enable_raw_mode()?;
-        ACTIVE.store(true, Ordering::SeqCst);
+        TERMINAL.open();
         // Made before the next step, so a failure there is undone too.
         let guard = Guard(());
-        execute!(io::stdout(), terminal::EnterAlternateScreen, cursor::Hide)?;
+        let mut out = io::stdout();
+        execute!(out, terminal::EnterAlternateScreen, cursor::Hide)?;
+        out.write_all(PASTE_ON)?;
+        out.flush()?;
         Ok(guard)
     }
 }
@@ -70,14 +162,15 @@ pub fn panicked() -> bool {
 /// Put the terminal back; safe to call more than once and from any thread.
 /// Errors are ignored: the terminal may already be gone.
 pub fn restore() {
-    if ACTIVE.swap(false, Ordering::SeqCst) {
+    TERMINAL.close(|| {
         let mut out = io::stdout();
         let _ = out.write_all(END_SYNC);
         let _ = out.write_all(b"\x1b[0m");
+        let _ = out.write_all(PASTE_OFF);
         let _ = execute!(out, cursor::Show, terminal::LeaveAlternateScreen);
         let _ = out.flush();
         let _ = terminal::disable_raw_mode();
-    }
+    });
 }
 
 /// How long the frame loop gets to exit by itself after a termination
@@ -111,58 +204,78 @@ pub fn spawn_signals(tx: Sender<Msg>) -> io::Result<signal_hook::iterator::Handl
     Ok(handle)
 }
 
-/// A named thread reading keys. It waits on the terminal itself and treats
-/// hang-up, errors and end of input as fatal: crossterm's own poll spins at
-/// full CPU on a terminal that has gone away (crossterm issue 793).
-pub fn spawn_input(tx: Sender<Msg>) -> io::Result<()> {
-    thread::Builder::new().name("input".into()).spawn(move || {
-        let fatal = |tx: &Sender<Msg>, why: String| {
-            let _ = tx.send(Msg::Fatal(why));
-        };
-        let stdin = io::stdin();
-        // Wake-ups that brought no event in a row: end of input.
-        let mut empty = 0u32;
-        loop {
-            use rustix::event::{PollFd, PollFlags};
-            let mut fds = [PollFd::new(&stdin, PollFlags::IN)];
-            match rustix::event::poll(&mut fds, None) {
-                Ok(_) => {}
-                Err(rustix::io::Errno::INTR) => continue,
-                Err(e) => return fatal(&tx, format!("terminal input failed: {e}")),
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::Arc;
+
+    #[derive(Clone, Default)]
+    struct Sink(Arc<parking_lot::Mutex<Vec<u8>>>);
+    impl Write for Sink {
+        fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+            self.0.lock().extend_from_slice(buf);
+            Ok(buf.len())
+        }
+        fn flush(&mut self) -> io::Result<()> {
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn nothing_is_written_after_the_terminal_is_restored() {
+        let latch: &'static Latch = Box::leak(Box::new(Latch::new()));
+        let sink = Sink::default();
+        let mut w = io::BufWriter::new(Gated::new(sink.clone(), latch));
+        latch.open();
+        w.write_all(b"frame 1").unwrap();
+        w.flush().unwrap();
+        // A frame half built when another thread restores the terminal.
+        w.write_all(b"frame 2").unwrap();
+        let restore = sink.clone();
+        std::thread::spawn(move || {
+            latch.close(|| restore.0.lock().extend_from_slice(b"|restored"))
+        })
+        .join()
+        .unwrap();
+        assert!(w.flush().is_err());
+        assert!(w.get_mut().write(b"x").is_err());
+        assert_eq!(&sink.0.lock()[..], b"frame 1|restored");
+        // Closing twice puts the terminal back once.
+        latch.close(|| sink.0.lock().extend_from_slice(b"again"));
+        assert_eq!(&sink.0.lock()[..], b"frame 1|restored");
+    }
+
+    #[test]
+    fn restore_waits_for_a_write_in_progress() {
+        let latch: &'static Latch = Box::leak(Box::new(Latch::new()));
+        latch.open();
+        let (started_tx, started) = crossbeam_channel::bounded(0);
+        let (go_tx, go) = crossbeam_channel::bounded::<()>(0);
+        struct Slow(
+            Sink,
+            crossbeam_channel::Sender<()>,
+            crossbeam_channel::Receiver<()>,
+        );
+        impl Write for Slow {
+            fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+                let _ = self.1.send(());
+                let _ = self.2.recv();
+                self.0.write(buf)
             }
-            let re = fds[0].revents();
-            if re.intersects(PollFlags::HUP | PollFlags::ERR | PollFlags::NVAL) {
-                return fatal(&tx, "the terminal went away".into());
-            }
-            let mut got = false;
-            loop {
-                match crossterm::event::poll(Duration::from_millis(1)) {
-                    Ok(true) => {}
-                    Ok(false) => break,
-                    Err(e) => return fatal(&tx, format!("terminal input failed: {e}")),
-                }
-                let msg = match crossterm::event::read() {
-                    Ok(Event::Key(k)) => Msg::Key(k),
-                    Ok(Event::Resize(..)) => Msg::Resize,
-                    Ok(_) => continue,
-                    Err(e) => return fatal(&tx, format!("terminal input failed: {e}")),
-                };
-                got = true;
-                if tx.send(msg).is_err() {
-                    return;
-                }
-            }
-            if got {
-                empty = 0;
-            } else {
-                empty += 1;
-                if empty >= 50 {
-                    return fatal(&tx, "terminal input ended".into());
-                }
-                // Readable yet nothing to read: don't turn into a spin.
-                thread::sleep(Duration::from_millis(5));
+            fn flush(&mut self) -> io::Result<()> {
+                Ok(())
             }
         }
-    })?;
-    Ok(())
+        let sink = Sink::default();
+        let mut w = Gated::new(Slow(sink.clone(), started_tx, go), latch);
+        let writer = std::thread::spawn(move || w.write_all(b"frame"));
+        started.recv().unwrap();
+        let s2 = sink.clone();
+        let closer =
+            std::thread::spawn(move || latch.close(|| s2.0.lock().extend_from_slice(b"|restored")));
+        go_tx.send(()).unwrap();
+        writer.join().unwrap().unwrap();
+        closer.join().unwrap();
+        assert_eq!(&sink.0.lock()[..], b"frame|restored");
+    }
 }

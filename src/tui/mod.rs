@@ -13,12 +13,16 @@ pub mod help;
 pub mod input;
 pub mod keys;
 pub mod output;
+pub mod pacing;
 pub mod projection;
+pub mod reader;
 pub mod readouts;
 pub mod run;
 pub mod state;
+pub mod term_input;
 pub mod theme;
 pub mod threads;
+pub mod writer;
 
 pub use run::run;
 pub use theme::ColorChoice;

@@ -24,6 +24,8 @@ pub struct Stats {
     pub collisions_per_second: f64,
     /// The palette the terminal says it can do.
     pub detected: Option<Palette>,
+    /// The link to the terminal as the pacing sees it (run.rs, pacing.rs).
+    pub link: Option<String>,
 }
 
 /// Rows of figures in the full form, and of the compact one.
@@ -158,7 +160,10 @@ impl Readouts<'_> {
             ),
             row(
                 "output",
-                format!("{:<8} per frame", human_bytes(st.frame_bytes)),
+                match &st.link {
+                    Some(link) => format!("{:<8} {link}", human_bytes(st.frame_bytes)),
+                    None => format!("{:<8} per frame", human_bytes(st.frame_bytes)),
+                },
             ),
         ]
     }

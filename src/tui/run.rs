@@ -2,20 +2,24 @@
 use super::app::{self, View};
 use super::canvas::Raster;
 use super::guard::{self, Guard, Msg};
-use super::output::{BEGIN_SYNC, BUFFER_BYTES, Counting, END_SYNC, Lean};
+use super::output::{BEGIN_SYNC, Counting, END_SYNC, Lean};
+use super::pacing::{self, Pacer};
 use super::readouts::Stats;
 use super::state::AppState;
 use super::theme::Palette;
-use super::{Options, input};
+use super::writer::Output;
+use super::{Options, input, reader};
 use crate::cpu::{CpuReport, Sampler};
 use crate::engine::{Command, Engine, Settings, Snapshot};
 use crate::error::BadInput;
 use crate::physics::World;
 use anyhow::{Context, anyhow};
-use crossbeam_channel::{Receiver, RecvTimeoutError};
+use crossbeam_channel::{Receiver, RecvTimeoutError, Sender};
 use ratatui::Terminal;
 use ratatui::backend::Backend;
-use std::io::{self, BufWriter, IsTerminal, Stdout, Write};
+use std::cell::RefCell;
+use std::io::{self, IsTerminal, Write};
+use std::rc::Rc;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -27,7 +31,7 @@ const SAMPLE_PERIOD: Duration = Duration::from_secs(1);
 pub fn run(world: World, settings: Settings, opts: Options) -> anyhow::Result<()> {
     if !(opts.fps.is_finite() && opts.fps > 0.0 && opts.fps <= 1000.0) {
         return Err(BadInput(format!(
-            "--fps must be between 0 and 1000, got {}",
+            "--fps must be greater than 0 and at most 1000, got {}",
             opts.fps
         ))
         .into());
@@ -57,7 +61,7 @@ pub fn run(world: World, settings: Settings, opts: Options) -> anyhow::Result<()
     let (tx, rx) = crossbeam_channel::unbounded();
     let guard = Guard::enter(tx.clone()).context("cannot set up the terminal")?;
     let signals = guard::spawn_signals(tx.clone())?;
-    guard::spawn_input(tx)?;
+    reader::spawn_input(tx.clone())?;
     // For the end-to-end test of a panic off the main thread.
     if std::env::var_os("BALLPIT_TEST_PANIC_THREAD").is_some() {
         std::thread::Builder::new()
@@ -67,19 +71,46 @@ pub fn run(world: World, settings: Settings, opts: Options) -> anyhow::Result<()
                 panic!("test panic in a worker thread");
             })?;
     }
-    let result = FrameLoop::new(engine, state, palette, detected).and_then(|l| l.run(rx));
+    let mut result = FrameLoop::new(engine, state, palette, detected, tx).and_then(|l| l.run(rx));
+    // A panic restores the terminal, so the frame loop may stop on a refused
+    // write first: the panic is the reason to report.
+    if result.is_err() && guard::panicked() {
+        result = Err(anyhow!("a thread panicked (message above)"));
+    }
     signals.close();
     drop(guard);
     result
 }
 
-type Term = Terminal<Lean<Counting<BufWriter<Stdout>>>>;
+type Term = Terminal<Lean<Counting<Sink>>>;
+
+/// Where a frame is built before it goes to the `output` thread.
+#[derive(Clone, Default)]
+struct Sink(Rc<RefCell<Vec<u8>>>);
+
+impl Write for Sink {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.0.borrow_mut().extend_from_slice(buf);
+        Ok(buf.len())
+    }
+    fn flush(&mut self) -> io::Result<()> {
+        Ok(())
+    }
+}
 
 struct FrameLoop {
     engine: Engine,
     state: AppState,
     palette: Palette,
     terminal: Term,
+    sink: Sink,
+    output: Output,
+    pacer: Pacer,
+    /// On a slow link, the snapshot last drawn: a key's update is drawn on
+    /// it, so only what the key changed crosses the link.
+    drawn: Option<Snapshot>,
+    /// A key was handled since the last frame went out.
+    update_wanted: bool,
     bytes: Arc<AtomicU64>,
     raster: Raster,
     stats: Stats,
@@ -116,8 +147,14 @@ impl FrameLoop {
         state: AppState,
         palette: Palette,
         detected: Palette,
+        events: Sender<Msg>,
     ) -> anyhow::Result<FrameLoop> {
-        let (writer, bytes) = Counting::new(BufWriter::with_capacity(BUFFER_BYTES, io::stdout()));
+        let output = Output::spawn(events)?;
+        // The start-up probe: does the terminal answer status requests?
+        output.send(pacing::QUERY.to_vec());
+        let pacer = Pacer::new(Instant::now());
+        let sink = Sink::default();
+        let (writer, bytes) = Counting::new(sink.clone());
         let mut terminal = Terminal::new(Lean::new(writer))?;
         // Not `Terminal::clear`: it asks the terminal for the cursor position,
         // a round trip that a slow link or a dumb pty may never answer.
@@ -131,6 +168,11 @@ impl FrameLoop {
             state,
             palette,
             terminal,
+            sink,
+            output,
+            pacer,
+            drawn: None,
+            update_wanted: false,
             bytes,
             raster: Raster::new(),
             stats: Stats {
@@ -158,11 +200,16 @@ impl FrameLoop {
         loop {
             let wants_frame =
                 self.state.running() || self.pending || self.dirty || self.in_flight.is_some();
-            let deadline = if wants_frame {
+            let mut deadline = if wants_frame {
                 next_frame.min(next_sample)
             } else {
                 next_sample
             };
+            if (self.dirty || self.update_wanted)
+                && let Some(t) = self.pacer.next_change()
+            {
+                deadline = deadline.min(t);
+            }
             let first = match rx.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
                 Ok(m) => Some(m),
                 Err(RecvTimeoutError::Timeout) => None,
@@ -170,9 +217,8 @@ impl FrameLoop {
                     return Err(anyhow!("the input and signal threads stopped"));
                 }
             };
-            let mut answered_key = false;
             for msg in first.into_iter().chain(rx.try_iter()) {
-                answered_key |= self.handle(msg)?;
+                self.update_wanted |= self.handle(msg)?;
             }
             if guard::panicked() {
                 return Err(anyhow!("a thread panicked (message above)"));
@@ -181,6 +227,7 @@ impl FrameLoop {
                 return Ok(());
             }
             let now = Instant::now();
+            self.pacer.tick(now);
             if now >= next_sample {
                 self.sample(now);
                 next_sample = later(next_sample, SAMPLE_PERIOD, now);
@@ -189,9 +236,8 @@ impl FrameLoop {
                 let period = Duration::from_secs_f64(1.0 / self.state.fps);
                 next_frame = later(next_frame, period, now);
                 self.frame()?;
-            } else if answered_key {
-                // Answer keys at once rather than at the next frame.
-                self.draw()?;
+            } else {
+                self.present()?;
             }
         }
     }
@@ -209,6 +255,14 @@ impl FrameLoop {
                 }
                 self.dirty = true;
                 Ok(true)
+            }
+            Msg::Status(at) => {
+                self.pacer.answered(at);
+                Ok(false)
+            }
+            Msg::Written => {
+                self.pacer.written();
+                Ok(false)
             }
             Msg::Resize => {
                 self.aspect = cell_aspect();
@@ -249,34 +303,75 @@ impl FrameLoop {
             self.in_flight = Some(self.pending);
             self.pending = false;
         }
-        if self.dirty {
-            self.draw()?;
-        }
-        Ok(())
+        self.present()
     }
 
-    fn draw(&mut self) -> anyhow::Result<()> {
+    /// Send what the link allows: a frame when the last one is on screen,
+    /// and a key's update at once (answer keys rather than wait for the
+    /// next frame).
+    fn present(&mut self) -> anyhow::Result<()> {
+        if self.dirty && self.pacer.may_send() {
+            self.draw(false)
+        } else if self.update_wanted && self.pacer.may_send_update() {
+            self.draw(true)
+        } else {
+            Ok(())
+        }
+    }
+
+    /// Draw a frame, or with `update` a key's answer that keeps the canvas
+    /// of the last frame when the link is slow.
+    fn draw(&mut self, update: bool) -> anyhow::Result<()> {
         let t0 = Instant::now();
         let before = self.bytes.load(Ordering::Relaxed);
+        let slow = self.pacer.slow();
+        let keep_canvas = update && slow && self.drawn.is_some();
+        if !keep_canvas {
+            self.drawn = slow.then(|| self.engine.snapshot().clone());
+        }
+        let snap = match (&self.drawn, keep_canvas) {
+            (Some(s), true) => s,
+            _ => self.engine.snapshot(),
+        };
         let view = View {
             state: &self.state,
-            snap: self.engine.snapshot(),
+            snap,
             stats: &self.stats,
             report: &self.report,
-            palette: self.palette,
+            // On a slow link, frames without colours are much smaller.
+            palette: if self.pacer.cheap() {
+                Palette::Mono
+            } else {
+                self.palette
+            },
             aspect: self.aspect,
         };
         let raster = &mut self.raster;
-        // Any write error means the terminal is gone: the `?`s end the app.
         self.terminal.backend_mut().write_all(BEGIN_SYNC)?;
         self.terminal.draw(|f| app::draw(f, raster, &view))?;
         let backend = self.terminal.backend_mut();
         backend.write_all(END_SYNC)?;
         Backend::flush(backend)?;
+        let frame = std::mem::take(&mut *self.sink.0.borrow_mut());
+        let asked = self.pacer.asks();
+        let chunk = if asked {
+            [pacing::QUERY, &frame, pacing::QUERY].concat()
+        } else {
+            frame
+        };
+        let len = chunk.len();
+        // A write error comes back from the output thread as Msg::Fatal.
+        if !self.output.send(chunk) {
+            return Err(anyhow!("the output thread stopped"));
+        }
+        self.pacer.sent(Instant::now(), len, asked);
         self.window.render_seconds += t0.elapsed().as_secs_f64();
         self.window.bytes += self.bytes.load(Ordering::Relaxed) - before;
         self.window.frames += 1;
-        self.dirty = false;
+        if !keep_canvas {
+            self.dirty = false;
+        }
+        self.update_wanted = false;
         Ok(())
     }
 
@@ -298,6 +393,7 @@ impl FrameLoop {
             st.render_seconds = w.render_seconds / f64::from(w.frames);
             st.frame_bytes = w.bytes / u64::from(w.frames);
         }
+        st.link = Some(self.pacer.describe());
         if w.physics_frames > 0 {
             st.physics_seconds = w.physics_seconds / f64::from(w.physics_frames);
         }

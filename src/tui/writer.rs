@@ -1,0 +1,42 @@
+//! The `output` thread: the one writer of frames. The frame loop hands it
+//! each frame's bytes and goes on handling keys, so a slow terminal never
+//! blocks the thread that answers them. It writes through the terminal's
+//! latch ([`guard::gated_stdout`]), so nothing lands after a restore.
+use super::guard::{self, Msg};
+use crossbeam_channel::Sender;
+use std::io::{self, Write};
+use std::thread;
+
+/// Where frames go: a channel to the `output` thread.
+pub struct Output {
+    tx: Sender<Vec<u8>>,
+}
+
+impl Output {
+    /// Start the thread; it reports each chunk written (or the error that
+    /// ended it) on `events`.
+    pub fn spawn(events: Sender<Msg>) -> io::Result<Output> {
+        let (tx, rx) = crossbeam_channel::unbounded::<Vec<u8>>();
+        thread::Builder::new()
+            .name("output".into())
+            .spawn(move || {
+                let mut out = guard::gated_stdout();
+                for chunk in rx {
+                    let msg = match out.write_all(&chunk).and_then(|()| out.flush()) {
+                        Ok(()) => Msg::Written,
+                        Err(e) => Msg::Fatal(format!("writing to the terminal failed: {e}")),
+                    };
+                    let fatal = matches!(msg, Msg::Fatal(_));
+                    if events.send(msg).is_err() || fatal {
+                        return;
+                    }
+                }
+            })?;
+        Ok(Output { tx })
+    }
+
+    /// Queue `bytes`; false if the thread has stopped.
+    pub fn send(&self, bytes: Vec<u8>) -> bool {
+        self.tx.send(bytes).is_ok()
+    }
+}
