@@ -49,6 +49,7 @@ fn stats() -> Stats {
         collisions_per_second: 12.0,
         detected: Some(Palette::True),
         link: None,
+        link_slow: false,
     }
 }
 
@@ -171,7 +172,7 @@ fn readouts_panel_says_exact_runs_on_one_thread_in_pool_mode() {
     st.model = ballpit::physics::ModelKind::Exact;
     let t = readouts(&st, &snapshot(), Palette::C16);
     let text = format!("{:?}", t.backend().buffer());
-    assert!(text.contains("pool     exact runs on physics"), "{text}");
+    assert!(text.contains("pool     exact on 1 pool thread"), "{text}");
 }
 
 #[test]
@@ -472,6 +473,45 @@ fn help_overlay_fits_at_80x24() {
         assert!(text.contains(b.help), "{} missing\n{text}", b.help);
     }
     assert!(text.contains("? or Esc closes this help"), "{text}");
+}
+
+#[test]
+fn a_slow_link_is_shown_at_80x24_in_place_of_the_render_time() {
+    let st = state();
+    let r = report_for(Threading::Off, 0);
+    let mut stats = stats();
+    stats.link = Some("109ms 16KB/s 5fps mono".into());
+    stats.link_slow = true;
+    let snap = snapshot();
+    let view = View {
+        state: &st,
+        snap: &snap,
+        stats: &stats,
+        report: &r,
+        palette: Palette::C16,
+        aspect: 2.0,
+    };
+    let mut raster = Raster::new();
+    let text = rows(&render(80, 24, |f| app::draw(f, &mut raster, &view))).join("\n");
+    assert!(
+        text.contains("link    109ms 16KB/s 5fps mono 4321 B/fr"),
+        "{text}"
+    );
+    assert!(!text.contains("render"), "{text}");
+    // A fast link keeps the render time.
+    let fast = Stats {
+        link_slow: false,
+        ..stats.clone()
+    };
+    let view = View {
+        stats: &fast,
+        ..view
+    };
+    let text = rows(&render(80, 24, |f| app::draw(f, &mut raster, &view))).join("\n");
+    assert!(
+        text.contains("render") && !text.contains("16KB/s"),
+        "{text}"
+    );
 }
 
 #[test]

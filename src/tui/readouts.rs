@@ -26,6 +26,9 @@ pub struct Stats {
     pub detected: Option<Palette>,
     /// The link to the terminal as the pacing sees it (run.rs, pacing.rs).
     pub link: Option<String>,
+    /// The link is slower than the frames: the compact form shows it in
+    /// place of the render time, as the reason the picture slowed.
+    pub link_slow: bool,
 }
 
 /// Rows of figures in the full form, and of the compact one.
@@ -51,9 +54,13 @@ impl Readouts<'_> {
         let threads = physics_threads(s.threading, s.threads);
         match s.threading {
             Threading::Off => format!("off      on main; t -> {}", s.last_threaded),
-            // The event loop of `exact` does not split: say where it runs.
-            t @ (Threading::Pool | Threading::Split) if s.model == ModelKind::Exact => {
-                format!("{:<8} exact runs on physics", t.name())
+            // The event loop of `exact` does not split: say where it runs
+            // (a pool hosts the whole frame on one of its threads).
+            Threading::Pool if s.model == ModelKind::Exact => {
+                format!("{:<8} exact on 1 pool thread", Threading::Pool.name())
+            }
+            Threading::Split if s.model == ModelKind::Exact => {
+                format!("{:<8} exact runs on physics", Threading::Split.name())
             }
             t => format!(
                 "{:<8} {threads} physics thread{}",
@@ -202,12 +209,18 @@ impl Readouts<'_> {
             ),
             pair("radius", self.radius(), "model", model),
             pair("fps", self.fps(true), "physics", self.physics_ms()),
-            pair(
-                "render",
-                format!("{:.2} ms", st.render_seconds * 1e3),
-                "output",
-                format!("{}/fr", human_bytes(st.frame_bytes)),
-            ),
+            match (&st.link, st.link_slow) {
+                (Some(link), true) => Line::from(vec![
+                    Span::styled(format!("{:<8}", "link"), label),
+                    Span::raw(format!("{link} {}/fr", human_bytes(st.frame_bytes))),
+                ]),
+                _ => pair(
+                    "render",
+                    format!("{:.2} ms", st.render_seconds * 1e3),
+                    "output",
+                    format!("{}/fr", human_bytes(st.frame_bytes)),
+                ),
+            },
             pair(
                 "drift",
                 format!("{:.1e}", snap.energy_drift()),

@@ -394,6 +394,7 @@ impl FrameLoop {
             st.frame_bytes = w.bytes / u64::from(w.frames);
         }
         st.link = Some(self.pacer.describe());
+        st.link_slow = self.pacer.slow();
         if w.physics_frames > 0 {
             st.physics_seconds = w.physics_seconds / f64::from(w.physics_frames);
         }
