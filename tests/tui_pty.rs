@@ -399,6 +399,38 @@ fn ctrl_c_and_esc_quit_cleanly() {
     }
 }
 
+/// A physics frame that takes seconds (20 000 dense spheres, 200 `swept`
+/// steps a frame) cannot be interrupted, but `q` and Ctrl-C still end the
+/// app within a second, with the terminal restored and exit code 0.
+#[test]
+fn quit_keys_end_the_app_promptly_during_a_long_physics_frame() {
+    for key in ["q", "\x03"] {
+        let args = [
+            "--scene",
+            "dense",
+            "--count",
+            "20000",
+            "--model",
+            "swept",
+            "--tick",
+            "200",
+            "--threading",
+            "worker",
+        ];
+        let mut app = start(&args, None);
+        app.wait_for("the readouts", 20.0, |s| s.contains("threading"));
+        // The first frame (seconds of physics) is in flight now.
+        let pressed = Instant::now();
+        app.send(key);
+        let st = app.wait_exit(5.0).expect("the key ends the app");
+        let took = pressed.elapsed();
+        assert!(st.success(), "{key:?}: {st:?}");
+        assert!(took < Duration::from_millis(1500), "{key:?} took {took:?}");
+        thread::sleep(Duration::from_millis(200));
+        assert!(!app.screen.lock().unwrap().screen().alternate_screen());
+    }
+}
+
 /// Issue 15, item 1: a key, a resize, then a key ended the app ("terminal
 /// input ended") and the second key went to the shell.
 #[test]

@@ -251,6 +251,12 @@ impl Engine {
         self.home.as_ref().map(|f| &f.world)
     }
 
+    /// Whether `finish_frame` would return without waiting: no frame is in
+    /// flight, or the one in flight is done.
+    pub fn frame_ready(&self) -> bool {
+        !self.in_flight || self.worker.ready()
+    }
+
     /// Whether a threaded frame is being computed.
     pub fn in_flight(&self) -> bool {
         self.in_flight

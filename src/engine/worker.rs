@@ -52,6 +52,12 @@ impl Worker {
             .ok_or_else(|| anyhow::anyhow!("the physics thread has stopped"))
     }
 
+    /// Whether the frame handed over last is back (or failed): `wait`
+    /// would not block.
+    pub fn ready(&self) -> bool {
+        !self.done.is_empty()
+    }
+
     pub fn wait(&self) -> Outcome {
         self.done
             .recv()

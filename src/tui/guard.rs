@@ -174,9 +174,18 @@ pub fn restore() {
 }
 
 /// How long the frame loop gets to exit by itself after a termination
-/// signal before the signal thread ends the process (the loop may be waiting
-/// on a long physics frame).
-const SIGNAL_GRACE: Duration = Duration::from_millis(700);
+/// signal or a quit key before the process is ended for it (the loop may be
+/// waiting on a long physics frame, which cannot be interrupted).
+pub const QUIT_GRACE: Duration = Duration::from_millis(700);
+
+/// Give the frame loop `QUIT_GRACE` to finish, then restore the terminal
+/// and end the process with `code`. Called on the thread that saw the
+/// request, which has nothing else left to do.
+pub fn end_after_grace(code: i32) -> ! {
+    thread::sleep(QUIT_GRACE);
+    restore();
+    std::process::exit(code);
+}
 
 /// A named thread turning signals into messages. Returns a handle whose
 /// `close` stops it.
@@ -196,9 +205,7 @@ pub fn spawn_signals(tx: Sender<Msg>) -> io::Result<signal_hook::iterator::Handl
                     continue;
                 }
                 let _ = tx.send(Msg::Signal(sig));
-                thread::sleep(SIGNAL_GRACE);
-                restore();
-                std::process::exit(128 + sig);
+                end_after_grace(128 + sig);
             }
         })?;
     Ok(handle)

@@ -61,9 +61,13 @@ fn read_loop(tx: &Sender<Msg>) -> Option<String> {
             Err(rustix::io::Errno::INTR) => {}
             Err(e) => return Some(format!("waiting for the terminal failed: {e}")),
         }
+        let mut quit = false;
         for ev in events.drain(..) {
             let msg = match ev {
-                Input::Key(k) => Msg::Key(k),
+                Input::Key(k) => {
+                    quit |= super::input::action(k) == Some(super::input::Action::Quit);
+                    Msg::Key(k)
+                }
                 // The pacing's answers: when they were read.
                 Input::StatusOk => Msg::Status(Instant::now()),
                 // Pastes, focus changes and cursor reports are not commands.
@@ -72,6 +76,11 @@ fn read_loop(tx: &Sender<Msg>) -> Option<String> {
             if tx.send(msg).is_err() {
                 return None;
             }
+        }
+        if quit {
+            // `q` and Ctrl-C end the app within a second even while a long
+            // physics frame holds the frame loop.
+            super::guard::end_after_grace(0);
         }
     }
 }

@@ -281,6 +281,11 @@ impl FrameLoop {
     /// period, the drawing and the wait for keys included, and the loop
     /// only waits for it when it is slower than the frame rate.
     fn frame(&mut self) -> anyhow::Result<()> {
+        if self.in_flight.is_some() && !self.engine.frame_ready() {
+            // The physics is slower than the frame rate: keep drawing and
+            // answering keys on the last snapshot rather than wait for it.
+            return self.present();
+        }
         if let Some(applied) = self.in_flight.take() {
             let snap = self.engine.finish_frame()?;
             self.window.steps += snap.steps;
