@@ -63,7 +63,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Some(Command::Tradeoff(args)) => {
             let world = scene::build_world(&args.scene.spec())?;
-            ballpit::tradeoff::run(world, args.out.as_deref())
+            let table = ballpit::tradeoff::run(world, args.out.as_deref())?;
+            Ok(emit(table.as_bytes())?)
         }
         Some(Command::Completions { shell }) => {
             let mut script = Vec::new();

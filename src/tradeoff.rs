@@ -263,9 +263,9 @@ pub fn svg(rows: &[Row], path: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Measure, print the table, and with `out` write `tradeoff.csv` and
-/// `tradeoff.svg` there.
-pub fn run(world: World, out: Option<&Path>) -> anyhow::Result<()> {
+/// Measure, and with `out` write `tradeoff.csv` and `tradeoff.svg` there;
+/// returns the table for the caller to print.
+pub fn run(world: World, out: Option<&Path>) -> anyhow::Result<String> {
     if let Some(dir) = out {
         // Before the minutes of measuring, not after: a bad path is bad input.
         std::fs::create_dir_all(dir).map_err(|e| {
@@ -273,12 +273,11 @@ pub fn run(world: World, out: Option<&Path>) -> anyhow::Result<()> {
         })?;
     }
     let rows = measure(&world);
-    print!("{}", markdown(&rows));
     if let Some(dir) = out {
         let csv_path = dir.join("tradeoff.csv");
         std::fs::write(&csv_path, csv(&rows))
             .with_context(|| format!("cannot write {}", csv_path.display()))?;
         svg(&rows, &dir.join("tradeoff.svg"))?;
     }
-    Ok(())
+    Ok(markdown(&rows))
 }

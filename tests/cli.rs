@@ -458,6 +458,22 @@ fn output_that_cannot_be_written_is_reported_not_a_panic() {
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("cannot write to stdout"), "{err}");
     assert!(!err.contains("panicked"), "{err}");
+    // `tradeoff` prints its table the same way.
+    let full = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .unwrap();
+    let out = std::process::Command::new(&bin)
+        .args(["tradeoff", "--count", "30"])
+        .stdout(full)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("cannot write to stdout") && !err.contains("panicked"),
+        "{err}"
+    );
     // A reader that went away: the pipe is closed before anything is written.
     let mut child = std::process::Command::new(&bin)
         .args(["bench", "--steps", "30", "--count", "2000"])
