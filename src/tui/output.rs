@@ -230,6 +230,28 @@ impl<W: Write> Write for Lean<W> {
     }
 }
 
+/// Where a frame is built before it goes to the `output` thread; clones
+/// share the bytes.
+#[derive(Clone, Default)]
+pub struct Sink(std::rc::Rc<std::cell::RefCell<Vec<u8>>>);
+
+impl Sink {
+    /// The bytes written so far, leaving it empty.
+    pub fn take(&self) -> Vec<u8> {
+        std::mem::take(&mut *self.0.borrow_mut())
+    }
+}
+
+impl Write for Sink {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.0.borrow_mut().extend_from_slice(buf);
+        Ok(buf.len())
+    }
+    fn flush(&mut self) -> io::Result<()> {
+        Ok(())
+    }
+}
+
 /// Big enough that a full 16-colour frame at 200×60 goes out in one write.
 pub const BUFFER_BYTES: usize = 256 * 1024;
 
@@ -246,20 +268,9 @@ mod tests {
         assert_eq!(w.inner.len(), 13);
     }
 
-    #[derive(Clone, Default)]
-    struct Sink(std::rc::Rc<std::cell::RefCell<Vec<u8>>>);
     impl Sink {
         fn text(&self) -> String {
             String::from_utf8(self.0.borrow().clone()).unwrap()
-        }
-    }
-    impl Write for Sink {
-        fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-            self.0.borrow_mut().extend_from_slice(buf);
-            Ok(buf.len())
-        }
-        fn flush(&mut self) -> io::Result<()> {
-            Ok(())
         }
     }
 

@@ -2,7 +2,7 @@
 use super::app::{self, View};
 use super::canvas::Raster;
 use super::guard::{self, Guard, Msg};
-use super::output::{BEGIN_SYNC, Counting, END_SYNC, Lean};
+use super::output::{BEGIN_SYNC, Counting, END_SYNC, Lean, Sink};
 use super::pacing::{self, Pacer};
 use super::readouts::Stats;
 use super::state::AppState;
@@ -17,9 +17,7 @@ use anyhow::{Context, anyhow};
 use crossbeam_channel::{Receiver, RecvTimeoutError, Sender};
 use ratatui::Terminal;
 use ratatui::backend::Backend;
-use std::cell::RefCell;
 use std::io::{self, IsTerminal, Write};
-use std::rc::Rc;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -83,20 +81,6 @@ pub fn run(world: World, settings: Settings, opts: Options) -> anyhow::Result<()
 }
 
 type Term = Terminal<Lean<Counting<Sink>>>;
-
-/// Where a frame is built before it goes to the `output` thread.
-#[derive(Clone, Default)]
-struct Sink(Rc<RefCell<Vec<u8>>>);
-
-impl Write for Sink {
-    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-        self.0.borrow_mut().extend_from_slice(buf);
-        Ok(buf.len())
-    }
-    fn flush(&mut self) -> io::Result<()> {
-        Ok(())
-    }
-}
 
 struct FrameLoop {
     engine: Engine,
@@ -357,7 +341,7 @@ impl FrameLoop {
         let backend = self.terminal.backend_mut();
         backend.write_all(END_SYNC)?;
         Backend::flush(backend)?;
-        let frame = std::mem::take(&mut *self.sink.0.borrow_mut());
+        let frame = self.sink.take();
         let asked = self.pacer.asks();
         let chunk = if asked {
             [pacing::QUERY, &frame, pacing::QUERY].concat()
