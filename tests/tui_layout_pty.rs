@@ -2,95 +2,14 @@
 //! 80x24 (the size most terminals open at), its screen parsed with vt100:
 //! every thread is on screen in every threading mode, and `c` shows the
 //! chart. Waits poll the screen with a deadline; nothing sleeps blind.
-use portable_pty::{CommandBuilder, PtySize, native_pty_system};
-use std::io::{Read, Write};
-use std::sync::{Arc, Mutex};
-use std::thread;
-use std::time::{Duration, Instant};
+// Each test file uses part of the shared helpers.
+#[allow(dead_code)]
+#[path = "common/pty.rs"]
+mod pty;
 
-struct App {
-    _master: Box<dyn portable_pty::MasterPty + Send>,
-    writer: Box<dyn Write + Send>,
-    child: Box<dyn portable_pty::Child + Send + Sync>,
-    screen: Arc<Mutex<vt100::Parser>>,
-}
-
-fn start(args: &[&str], cols: u16, rows: u16) -> App {
-    let pty = native_pty_system()
-        .openpty(PtySize {
-            rows,
-            cols,
-            pixel_width: 0,
-            pixel_height: 0,
-        })
-        .expect("openpty");
-    let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_ballpit"));
-    cmd.args(args);
-    cmd.env("TERM", "xterm-256color");
-    let child = pty.slave.spawn_command(cmd).expect("spawn ballpit");
-    drop(pty.slave);
-    let mut reader = pty.master.try_clone_reader().expect("reader");
-    let writer = pty.master.take_writer().expect("writer");
-    let nz = |n| std::num::NonZeroU16::new(n).unwrap();
-    let screen = Arc::new(Mutex::new(vt100::Parser::new(nz(rows), nz(cols), 0)));
-    let s = screen.clone();
-    thread::spawn(move || {
-        let mut buf = [0u8; 65536];
-        while let Ok(n @ 1..) = reader.read(&mut buf) {
-            s.lock().unwrap().process(&buf[..n]);
-        }
-    });
-    App {
-        _master: pty.master,
-        writer,
-        child,
-        screen,
-    }
-}
-
-impl App {
-    fn text(&self) -> String {
-        self.screen.lock().unwrap().screen().contents()
-    }
-
-    fn send(&mut self, keys: &str) {
-        self.writer.write_all(keys.as_bytes()).unwrap();
-        self.writer.flush().unwrap();
-    }
-
-    fn wait_for(&self, what: &str, secs: f64, pred: impl Fn(&str) -> bool) -> String {
-        let end = Instant::now() + Duration::from_secs_f64(secs);
-        loop {
-            let t = self.text();
-            if pred(&t) {
-                return t;
-            }
-            assert!(
-                Instant::now() < end,
-                "timed out waiting for {what}; screen:\n{t}"
-            );
-            thread::sleep(Duration::from_millis(50));
-        }
-    }
-
-    fn quit(mut self) {
-        self.send("q");
-        let end = Instant::now() + Duration::from_secs(5);
-        while Instant::now() < end {
-            if let Some(st) = self.child.try_wait().unwrap() {
-                assert!(st.success(), "{st:?}");
-                return;
-            }
-            thread::sleep(Duration::from_millis(20));
-        }
-        panic!("q did not end the app");
-    }
-}
-
-impl Drop for App {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-    }
+/// The app at `cols`×`rows`.
+fn start(args: &[&str], cols: u16, rows: u16) -> pty::App {
+    pty::start_with(args, None, (rows, cols), "xterm-256color")
 }
 
 /// Grid cells of the thread panel (idle dot or a bar).
