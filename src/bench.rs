@@ -51,6 +51,28 @@ pub struct BenchReport {
     pub capped_steps: u64,
     pub thread_cpu: Vec<ThreadCpu>,
     pub peak_rss_bytes: u64,
+    /// Where the run could not keep a model's promise, and why (empty when
+    /// it kept them all).
+    pub warnings: Vec<String>,
+}
+
+/// What a reader of `report` must know before trusting its figures: the
+/// promises the run could not keep, and why.
+pub fn warnings(report: &BenchReport) -> Vec<String> {
+    let mut w = Vec::new();
+    if report.capped_steps > 0 {
+        w.push(format!(
+            "{} steps hit the event cap and were finished in free flight, skipping contacts: overlaps up to {:.2e} r remain at the end (a smaller --dt or --speed avoids the cap)",
+            report.capped_steps, report.max_overlap_rel
+        ));
+    }
+    if report.escaped > 0 {
+        w.push(format!("{} spheres ended outside the cube", report.escaped));
+    }
+    if report.n > 0 && report.energy_start == 0.0 {
+        w.push("every sphere is at rest: the energy figures are 0 and say nothing".into());
+    }
+    w
 }
 
 /// Run `steps` steps through the engine in frames of `settings.tick` steps
@@ -150,6 +172,11 @@ pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(Ben
         capped_steps: c.capped_steps,
         thread_cpu,
         peak_rss_bytes: peak_rss_bytes(),
+        warnings: Vec::new(),
+    };
+    let report = BenchReport {
+        warnings: warnings(&report),
+        ..report
     };
     Ok((report, world))
 }

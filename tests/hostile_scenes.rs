@@ -333,3 +333,35 @@ mod fuzz {
         }
     }
 }
+
+/// A run that could not keep a promise says which and why in its JSON.
+#[test]
+fn bench_json_says_which_promise_a_run_could_not_keep() {
+    let warnings = |args: &[&str]| {
+        let out = ballpit().arg("bench").args(args).output().unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let w: Vec<String> = v["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|s| s.as_str().unwrap().to_string())
+            .collect();
+        (v, w)
+    };
+    // 10^4 box lengths a second: the event cap is hit and contacts skipped.
+    let (v, w) = warnings(&["--steps", "2", "--speed", "1e4", "--model", "exact"]);
+    assert!(v["capped_steps"].as_u64().unwrap() > 0);
+    assert!(
+        w.len() == 1 && w[0].contains("hit the event cap") && w[0].contains("overlaps up to"),
+        "{w:?}"
+    );
+    let (_, w) = warnings(&["--steps", "2", "--speed", "0"]);
+    assert!(w.len() == 1 && w[0].contains("at rest"), "{w:?}");
+    let (_, w) = warnings(&["--steps", "2"]);
+    assert!(w.is_empty(), "{w:?}");
+}

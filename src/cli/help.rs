@@ -67,6 +67,10 @@ pub const BENCH_FIELDS: &[(&str, &str)] = &[
         "[{name, cpu_seconds}] for every thread of the process",
     ),
     ("peak_rss_bytes", "peak resident memory of the process"),
+    (
+        "warnings",
+        "the promises the run could not keep, and why (empty when none)",
+    ),
 ];
 
 pub(super) fn bench_after_help() -> String {

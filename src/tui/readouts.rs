@@ -246,7 +246,7 @@ impl Readouts<'_> {
         } else if self.snap.counters.capped_steps > 0 {
             // A capped step skipped contacts: say so, it explains overlaps.
             Some(format!(
-                " event cap hit in {} steps ",
+                " event cap hit in {} steps: contacts skipped, overlaps possible ",
                 self.snap.counters.capped_steps
             ))
         } else {
