@@ -1,0 +1,126 @@
+//! Regression pin for the exact model's layout work (issue 20): fixed scenes
+//! must give, bit for bit, the contacts and final state they gave before the
+//! cell storage was made compact. The checksums were produced by this test's
+//! `checksum` on the code of main at 446c9af (before any change on the
+//! `scale` branch), printed by running it with `PIN_PRINT=1`.
+use ballpit::physics::exact::Exact;
+use ballpit::physics::exact::lattice::lattice_world;
+use ballpit::physics::{Model, Serial, Sphere, World};
+use ballpit::scene::{SceneSpec, build_world};
+use glam::DVec3;
+use std::sync::{Arc, Mutex};
+
+/// FNV-1a over 64-bit words.
+#[derive(Clone, Copy)]
+struct Fnv(u64);
+
+impl Fnv {
+    fn new() -> Self {
+        Fnv(0xcbf2_9ce4_8422_2325)
+    }
+    fn word(&mut self, w: u64) {
+        for b in w.to_le_bytes() {
+            self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+}
+
+/// Runs `steps` steps of `dt` and hashes every contact (spheres, time and
+/// impulse bits) and the final positions, velocities and counters.
+fn checksum(mut w: World, dt: f64, steps: u64) -> (u64, u64, World) {
+    let contacts = Arc::new(Mutex::new((Fnv::new(), 0u64)));
+    let sink = Arc::clone(&contacts);
+    let mut m = Exact::default();
+    m.set_observer(Some(Box::new(move |c| {
+        let mut s = sink.lock().expect("observer lock");
+        for word in [
+            c.i as u64,
+            c.j as u64,
+            c.time.to_bits(),
+            c.impulse.to_bits(),
+        ] {
+            s.0.word(word);
+        }
+        s.1 += 1;
+    })));
+    m.advance(&mut w, dt, steps, &Serial);
+    let mut h = contacts.lock().expect("observer lock").0;
+    for s in &w.spheres {
+        for x in [s.pos.x, s.pos.y, s.pos.z, s.vel.x, s.vel.y, s.vel.z] {
+            h.word(x.to_bits());
+        }
+    }
+    h.word(w.counters.sphere_collisions);
+    h.word(w.counters.wall_collisions);
+    h.word(w.counters.wall_momentum.to_bits());
+    h.word(w.time.to_bits());
+    let n = contacts.lock().expect("observer lock").1;
+    (h.0, n, w)
+}
+
+fn scene(name: &str, count: usize, radius: Option<f64>, seed: u64) -> World {
+    build_world(&SceneSpec {
+        scene: Some(name.into()),
+        count: Some(count),
+        radius,
+        seed: Some(seed),
+        ..Default::default()
+    })
+    .expect("scene")
+}
+
+fn pin(label: &str, w: World, dt: f64, steps: u64, want: (u64, u64)) {
+    let e0 = w.kinetic_energy();
+    let (h, n, w) = checksum(w, dt, steps);
+    if std::env::var_os("PIN_PRINT").is_some() {
+        println!("{label}: (0x{h:016x}, {n})");
+    }
+    // The invariants too, so the pinned run is a sound one.
+    assert!(n > 1000, "{label}: only {n} contacts");
+    assert_eq!(w.escaped(), 0);
+    assert!((w.kinetic_energy() - e0).abs() <= 1e-10 * e0);
+    assert!(w.max_overlap_rel() <= 1e-9);
+    assert_eq!((h, n), want, "{label}: checksum and contact count");
+}
+
+/// Dilute: cell crossings on a grid capped by the sphere count.
+#[test]
+fn dilute_gas_is_bit_identical() {
+    let w = scene("gas", 5000, Some(0.0062), 5);
+    pin("dilute", w, 1.0 / 60.0, 200, (0xa48ce16c39826093, 13431));
+}
+
+/// Moderate: cells about a diameter wide.
+#[test]
+fn moderate_gas_is_bit_identical() {
+    let w = scene("gas", 5000, Some(0.0168), 5);
+    pin("moderate", w, 1.0 / 60.0, 40, (0xfcebd05c54f563d2, 26431));
+}
+
+/// A gas with three spheres 15x larger: those on the second level of the cells.
+#[test]
+fn large_spheres_among_small_are_bit_identical() {
+    let gas = scene("gas", 4000, Some(0.005), 5);
+    let big = [[0.25, 0.3, 0.4], [0.7, 0.6, 0.5], [0.4, 0.75, 0.7]]
+        .map(|p| Sphere::new(DVec3::from(p), DVec3::new(0.3, -0.2, 0.1), 0.075));
+    let clear = |s: &Sphere| {
+        big.iter()
+            .all(|b| s.pos.distance(b.pos) > s.radius + b.radius)
+    };
+    let mut spheres: Vec<Sphere> = gas.spheres.into_iter().filter(clear).collect();
+    spheres.extend(big);
+    pin(
+        "large",
+        World::new(1.0, spheres),
+        1.0 / 60.0,
+        200,
+        (0xd50f13609f9f0d04, 6256),
+    );
+}
+
+/// Dense: neighbour lists.
+#[test]
+fn dense_lattice_is_bit_identical() {
+    let w = lattice_world(2000, 0.4, 1.0, 5).expect("lattice");
+    pin("dense", w, 1.0 / 200.0, 20, (0x912962952d536339, 22093));
+}
