@@ -111,6 +111,14 @@ impl Cells {
         }
     }
 
+    /// Bytes held on the heap.
+    pub fn heap_bytes(&self) -> usize {
+        self.coord.capacity() * size_of::<[u32; 3]>()
+            + self.list.heap_bytes()
+            + (self.bigs.capacity() + self.big_slot.capacity()) * 4
+            + self.scan_centre.capacity() * size_of::<DVec3>()
+    }
+
     #[inline]
     pub fn is_big(&self, i: usize) -> bool {
         self.big_slot[i] != NONE

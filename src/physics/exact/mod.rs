@@ -157,6 +157,22 @@ impl Exact {
         self.observer = f;
     }
 
+    /// Bytes the model holds on the heap (its copy of the spheres, the
+    /// schedule and the broad phase; not the world's own spheres).
+    pub fn heap_bytes(&self) -> usize {
+        let broad = match &self.broad {
+            Broad::Lists(nl) => nl.heap_bytes(),
+            Broad::Cells(cells) => cells.heap_bytes(),
+        };
+        self.bodies.capacity() * size_of::<Body>()
+            + self.mass.capacity() * 8
+            + (self.order.capacity() + self.counts.capacity() + self.candidates.capacity()) * 4
+            + self.events.capacity() * size_of::<Event>()
+            + self.pending.capacity() * size_of::<(f64, Event)>()
+            + self.queue.heap_bytes()
+            + broad
+    }
+
     fn event_cap(&self) -> u64 {
         self.cap
             .unwrap_or(EVENT_CAP_BASE + EVENT_CAP_PER_SPHERE * self.bodies.len() as u64)
@@ -188,10 +204,23 @@ impl Exact {
         let cell = |x: f64| ((x / world.size * side as f64) as usize).min(side - 1);
         let key =
             |p: DVec3| cell(p.x.max(0.0)) + side * (cell(p.y.max(0.0)) + side * cell(p.z.max(0.0)));
+        // A counting sort by cell: linear, and stable (ties in world order),
+        // so the order is the one a stable sort by key gives.
+        let keys: Vec<u32> = world.spheres.iter().map(|s| key(s.pos) as u32).collect();
+        let mut start = vec![0u32; side * side * side + 1];
+        for &k in &keys {
+            start[k as usize + 1] += 1;
+        }
+        for c in 1..start.len() {
+            start[c] += start[c - 1];
+        }
         self.order.clear();
-        self.order.extend(0..n as u32);
-        self.order
-            .sort_by_key(|&k| key(world.spheres[k as usize].pos));
+        self.order.resize(n, 0);
+        for (i, &k) in keys.iter().enumerate() {
+            let at = &mut start[k as usize];
+            self.order[*at as usize] = i as u32;
+            *at += 1;
+        }
         self.bodies.clear();
         self.bodies.extend(
             self.order
