@@ -8,13 +8,24 @@
 //!
 //! `cargo run --release --example scaling -- [rounds] [sorted]`
 //!
+//! `cargo run --release --example scaling -- exact [rounds] [max N]`:
+//! the exact model at 10k, 100k and 1M spheres (up to `max N`), packing
+//! 0.005 and 0.1 (the radius set by N, the box 1, seed 5, as
+//! `ballpit bench --count N --radius R --seed 5`). Per size: the time to
+//! load the spheres (the first advance, a step of 1e-9 s), the model's heap
+//! bytes per sphere, then blocks of steps timed in alternation between the
+//! sizes: ns per sphere-step and events (collisions, crossings, walls,
+//! relists, stale) per second, and that rate against the 10k one.
+//! `exact-one N packing steps` runs one size only (for callgrind).
+//!
 //! With `sorted`, both worlds are sorted in space (by cell of the 10k
 //! scene's grid, z then y then x) before every block, outside the timing:
 //! how much a world kept in spatial order for free would buy. The model
 //! itself never reorders the world (the screen, the CSV and the model
 //! comparisons read spheres by index).
+use ballpit::physics::exact::{EventStats, Exact};
 use ballpit::physics::sphere::volume;
-use ballpit::physics::{ModelKind, Serial, World};
+use ballpit::physics::{Model, ModelKind, Serial, World};
 use ballpit::scene::{SceneSpec, build_world};
 use std::time::{Duration, Instant};
 
@@ -44,8 +55,103 @@ fn sort_in_space(world: &mut World, cell: f64) {
         .sort_by_key(|s| (c(s.pos.z) * side + c(s.pos.y)) * side + c(s.pos.x));
 }
 
+/// The exact benchmark's scene: `n` spheres filling `packing` of the unit box.
+fn exact_scene(n: usize, packing: f64) -> World {
+    let radius = (packing / (n as f64 * volume(1.0))).cbrt();
+    build_world(&SceneSpec {
+        count: Some(n),
+        radius: Some(radius),
+        seed: Some(5),
+        ..Default::default()
+    })
+    .expect("scene")
+}
+
+fn events(s: &EventStats) -> u64 {
+    s.pairs + s.stale + s.walls + s.relists + s.crossings
+}
+
+fn exact_one(args: &[String]) {
+    let num = |k: usize| args.get(k).and_then(|a| a.parse::<f64>().ok());
+    let (n, packing, steps) = (
+        num(0).expect("N") as usize,
+        num(1).expect("packing"),
+        num(2).expect("steps") as u64,
+    );
+    let mut world = exact_scene(n, packing);
+    let mut model = Exact::default();
+    let start = Instant::now();
+    model.advance(&mut world, 1e-9, 1, &Serial);
+    let load = start.elapsed();
+    let e0 = events(&model.stats);
+    // A step holds about 2 events a sphere at 10k, packing 0.1.
+    model.advance(&mut world, 1e-3 * 10_000.0 / n as f64, steps, &Serial);
+    println!(
+        "{n} spheres, packing {packing}: load {:.3} s, {} bytes a sphere, {} events ({:?})",
+        load.as_secs_f64(),
+        model.heap_bytes() / n.max(1),
+        events(&model.stats) - e0,
+        model.stats
+    );
+}
+
+fn exact_scaling(args: &[String]) {
+    let rounds: usize = args.first().map_or(5, |r| r.parse().expect("rounds"));
+    let max: usize = args.get(1).map_or(1_000_000, |m| m.parse().expect("max N"));
+    let sizes: Vec<usize> = [10_000, 100_000, 1_000_000]
+        .into_iter()
+        .filter(|&n| n <= max)
+        .collect();
+    for packing in [0.005, 0.1] {
+        let mut runs = Vec::new();
+        for &n in &sizes {
+            let mut world = exact_scene(n, packing);
+            let mut model = Exact::default();
+            let start = Instant::now();
+            model.advance(&mut world, 1e-9, 1, &Serial);
+            let load = start.elapsed().as_secs_f64();
+            let bytes = model.heap_bytes() as f64 / n as f64;
+            // Steps of about the same events in all sizes: dt shrinks as N grows.
+            let dt = 0.02 * 10_000.0 / n as f64;
+            runs.push((n, world, model, dt, load, bytes, Duration::ZERO, 0u64, 0u64));
+        }
+        for _ in 0..rounds {
+            for (_, world, model, dt, _, _, spent, evs, steps) in &mut runs {
+                model.advance(world, *dt, 1, &Serial);
+                let e0 = events(&model.stats);
+                let start = Instant::now();
+                model.advance(world, *dt, 4, &Serial);
+                *spent += start.elapsed();
+                *evs += events(&model.stats) - e0;
+                *steps += 4;
+            }
+        }
+        let base = runs[0].7 as f64 / runs[0].6.as_secs_f64();
+        for (n, world, _, _, load, bytes, spent, evs, steps) in &runs {
+            let secs = spent.as_secs_f64();
+            let rate = *evs as f64 / secs;
+            println!(
+                "exact packing {packing} N {n}: load {load:.3} s, {bytes:.0} model bytes a sphere, \
+                 {:.0} ns a sphere-step, {:.3} M events/s (10k rate / this: {:.2}), {:.0} ns an event, \
+                 {} events, escaped {}",
+                secs / (*steps as f64 * *n as f64) * 1e9,
+                rate / 1e6,
+                base / rate,
+                secs / *evs as f64 * 1e9,
+                evs,
+                world.escaped()
+            );
+        }
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    match args.first().map(String::as_str) {
+        Some("exact") => return exact_scaling(&args[1..]),
+        Some("exact-one") => return exact_one(&args[1..]),
+        _ => {}
+    }
     let sorted = args.iter().any(|a| a == "sorted");
     let rounds: usize = args
         .iter()
