@@ -33,8 +33,8 @@ pub struct Cells {
     stencil: [usize; 27],
     layers: [[usize; 9]; 8],
     /// Each small sphere's cell coordinates (unpadded), kept so that events
-    /// need no integer division.
-    coord: Vec<[u32; 3]>,
+    /// need no integer division; `u16` as a side has at most 512 cells.
+    coord: Vec<[u16; 3]>,
     cell: f64,
     /// The small spheres of each cell; large ones are in no cell.
     list: CellSlots,
@@ -78,7 +78,7 @@ impl Cells {
                 self.scan_centre.push(b.pos);
             } else {
                 let c = self.coords(b.pos);
-                self.coord[i] = c.map(|x| x as u32);
+                self.coord[i] = c.map(|x| x as u16);
                 self.list.insert(i, self.index(c));
             }
         }
@@ -113,7 +113,7 @@ impl Cells {
 
     /// Bytes held on the heap.
     pub fn heap_bytes(&self) -> usize {
-        self.coord.capacity() * size_of::<[u32; 3]>()
+        self.coord.capacity() * size_of::<[u16; 3]>()
             + self.list.heap_bytes()
             + (self.bigs.capacity() + self.big_slot.capacity()) * 4
             + self.scan_centre.capacity() * size_of::<DVec3>()
@@ -148,6 +148,7 @@ impl Cells {
         // branch on them mispredicts half the time (and LLVM turns plain
         // selects back into such branches; indexing does not).
         for (k, &ck) in coord.iter().enumerate() {
+            let ck = u32::from(ck);
             let v = b.vel[k];
             let up = v > 0.0;
             let face = ck + up as u32;
