@@ -16,7 +16,7 @@
 //! bytes per sphere, then blocks of steps timed in alternation between the
 //! sizes: ns per sphere-step and events (collisions, crossings, walls,
 //! relists, stale) per second, and that rate against the 10k one.
-//! `exact-one N packing steps` runs one size only (for callgrind).
+//! `exact-one N packing steps [dt]` runs one size only (for callgrind).
 //!
 //! With `sorted`, both worlds are sorted in space (by cell of the 10k
 //! scene's grid, z then y then x) before every block, outside the timing:
@@ -78,21 +78,45 @@ fn exact_one(args: &[String]) {
         num(1).expect("packing"),
         num(2).expect("steps") as u64,
     );
+    let empty = status_kib("VmRSS");
     let mut world = exact_scene(n, packing);
+    let (scene_peak, scene_rss) = (status_kib("VmHWM"), status_kib("VmRSS"));
     let mut model = Exact::default();
     let start = Instant::now();
     model.advance(&mut world, 1e-9, 1, &Serial);
     let load = start.elapsed();
     let e0 = events(&model.stats);
-    // A step holds about 2 events a sphere at 10k, packing 0.1.
-    model.advance(&mut world, 1e-3 * 10_000.0 / n as f64, steps, &Serial);
+    let start = Instant::now();
+    // By default a step holds about 400 events whatever N (packing 0.005).
+    let dt = num(3).unwrap_or(1e-3 * 10_000.0 / n as f64);
+    model.advance(&mut world, dt, steps, &Serial);
+    let secs = start.elapsed().as_secs_f64();
+    let ev = events(&model.stats) - e0;
+    let per = |kib: u64| (kib.saturating_sub(empty) * 1024) as f64 / n.max(1) as f64;
     println!(
-        "{n} spheres, packing {packing}: load {:.3} s, {} bytes a sphere, {} events ({:?})",
+        "{n} spheres, packing {packing}: load {:.3} s, model heap {} bytes a sphere; \
+         RSS a sphere: {:.0} after the scene (peak {:.0}), {:.0} after the steps (peak {:.0}); \
+         {ev} events, {:.3} M/s ({:?})",
         load.as_secs_f64(),
         model.heap_bytes() / n.max(1),
-        events(&model.stats) - e0,
+        per(scene_rss),
+        per(scene_peak),
+        per(status_kib("VmRSS")),
+        per(status_kib("VmHWM")),
+        ev as f64 / secs / 1e6,
         model.stats
     );
+}
+
+/// A `kB` field of /proc/self/status (0 where there is none).
+fn status_kib(field: &str) -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|t| {
+            let line = t.lines().find(|l| l.starts_with(field))?.to_owned();
+            line.split_whitespace().nth(1)?.parse().ok()
+        })
+        .unwrap_or(0)
 }
 
 fn exact_scaling(args: &[String]) {
