@@ -126,6 +126,7 @@ pub struct Exact {
     synced_time: f64,
     valid: bool,
     cap: Option<u64>,
+    cells_per_sphere: Option<u32>,
     observer: Option<Observer>,
     /// Events processed since construction, by kind.
     pub stats: EventStats,
@@ -149,6 +150,13 @@ impl Exact {
     /// [`EVENT_CAP_PER_SPHERE`] per sphere).
     pub fn with_event_cap(mut self, cap: u64) -> Self {
         self.cap = Some(cap);
+        self
+    }
+
+    /// Set the most cells per sphere of the cell grid (default
+    /// [`cells::CELLS_PER_SPHERE`]; at least 1), for comparing grids.
+    pub fn with_cells_per_sphere(mut self, k: u32) -> Self {
+        self.cells_per_sphere = Some(k.max(1));
         self
     }
 
@@ -255,7 +263,8 @@ impl Exact {
             self.broad = Broad::Lists(nl);
         } else {
             let mut cells = Box::<Cells>::default();
-            cells.build(&self.bodies, self.size);
+            let per_sphere = self.cells_per_sphere.unwrap_or(cells::CELLS_PER_SPHERE);
+            cells.build(&self.bodies, self.size, per_sphere);
             self.broad = Broad::Cells(cells);
         }
         self.queue.reset(n);
