@@ -155,7 +155,7 @@ fn pair(c: &(usize, usize, f64)) -> (usize, usize) {
 /// The default grid (fewer, larger cells) takes the contacts the old grid
 /// took, in the same order, at times equal to 1e-12, until the paths part
 /// (chaos amplifies the last bits a crossing leaves in a position; on these
-/// scenes after 1449 of 13431 contacts, dilute, and 5648 of 26431).
+/// scenes after 1594 of 13431 contacts, dilute, and 5648 of 26431).
 #[test]
 fn the_default_grid_takes_the_old_grids_contacts() {
     for (packing_radius, steps) in [(0.0062, 200), (0.0168, 40)] {

@@ -22,9 +22,10 @@ const BIG_FACTOR: f64 = 3.0;
 /// Most cells the grid may have per sphere, by default: in dilute scenes
 /// cells a diameter wide would number far more than the spheres, and an
 /// almost empty grid costs memory and cache without saving work (fewer,
-/// larger cells also mean fewer crossings). Measured at 10k to 1M spheres,
-/// packing 0.005 and 0.1 (16 before: 2.2x the model's memory at 1M).
-pub const CELLS_PER_SPHERE: u32 = 2;
+/// larger cells also mean fewer crossings). 4 measured best over 10k to 1M
+/// spheres at packing 0.005 and 0.1: 2 was as fast when dilute but slower at
+/// 0.1, where cells a diameter wide are about 5 a sphere.
+pub const CELLS_PER_SPHERE: u32 = 4;
 
 #[derive(Clone, Debug, Default)]
 pub struct Cells {
