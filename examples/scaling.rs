@@ -13,9 +13,10 @@
 //! 0.005 and 0.1 (the radius set by N, the box 1, seed 5, as
 //! `ballpit bench --count N --radius R --seed 5`). Per size: the time to
 //! load the spheres (the first advance, a step of 1e-9 s), the model's heap
-//! bytes per sphere, then blocks of steps timed in alternation between the
-//! sizes: ns per sphere-step and events (collisions, crossings, walls,
-//! relists, stale) per second, and that rate against the 10k one.
+//! bytes per sphere, then blocks of steps of 2 ms (100 at 10k, 10 at 100k, 2
+//! at 1M) timed in alternation between the sizes: ns per sphere-step and
+//! events (collisions, crossings, walls, relists, stale) per second, and the
+//! 10k rate over that rate.
 //! `exact-one N packing steps [dt]` runs one size only (for callgrind).
 //!
 //! With `sorted`, both worlds are sorted in space (by cell of the 10k
@@ -66,6 +67,9 @@ fn exact_scene(n: usize, packing: f64) -> World {
     })
     .expect("scene")
 }
+
+/// The exact runs' step: about 400 events at 10k spheres, packing 0.005.
+const DT_EXACT: f64 = 2e-3;
 
 fn events(s: &EventStats) -> u64 {
     s.pairs + s.stale + s.walls + s.relists + s.crossings
@@ -119,6 +123,20 @@ fn status_kib(field: &str) -> u64 {
         .unwrap_or(0)
 }
 
+/// One size of the exact runs and what its timed blocks add up to.
+struct Run {
+    n: usize,
+    world: World,
+    model: Exact,
+    /// Steps a timed block.
+    block: u64,
+    load: f64,
+    bytes: f64,
+    spent: Duration,
+    events: u64,
+    steps: u64,
+}
+
 fn exact_scaling(args: &[String]) {
     let rounds: usize = args.first().map_or(5, |r| r.parse().expect("rounds"));
     let max: usize = args.get(1).map_or(1_000_000, |m| m.parse().expect("max N"));
@@ -135,35 +153,50 @@ fn exact_scaling(args: &[String]) {
             model.advance(&mut world, 1e-9, 1, &Serial);
             let load = start.elapsed().as_secs_f64();
             let bytes = model.heap_bytes() as f64 / n as f64;
-            // Steps of about the same events in all sizes: dt shrinks as N grows.
-            let dt = 0.02 * 10_000.0 / n as f64;
-            runs.push((n, world, model, dt, load, bytes, Duration::ZERO, 0u64, 0u64));
+            runs.push(Run {
+                n,
+                world,
+                model,
+                // The same dt at every size, so the per-step work outside
+                // the event loop (checking and writing back the world,
+                // linear in N) stays a small share; fewer steps as N grows.
+                block: (1_000_000 / n as u64).max(2),
+                load,
+                bytes,
+                spent: Duration::ZERO,
+                events: 0,
+                steps: 0,
+            });
         }
         for _ in 0..rounds {
-            for (_, world, model, dt, _, _, spent, evs, steps) in &mut runs {
-                model.advance(world, *dt, 1, &Serial);
-                let e0 = events(&model.stats);
+            for r in &mut runs {
+                // Untimed: the caches after the other sizes.
+                r.model.advance(&mut r.world, DT_EXACT, 1, &Serial);
+                let e0 = events(&r.model.stats);
                 let start = Instant::now();
-                model.advance(world, *dt, 4, &Serial);
-                *spent += start.elapsed();
-                *evs += events(&model.stats) - e0;
-                *steps += 4;
+                r.model.advance(&mut r.world, DT_EXACT, r.block, &Serial);
+                r.spent += start.elapsed();
+                r.events += events(&r.model.stats) - e0;
+                r.steps += r.block;
             }
         }
-        let base = runs[0].7 as f64 / runs[0].6.as_secs_f64();
-        for (n, world, _, _, load, bytes, spent, evs, steps) in &runs {
-            let secs = spent.as_secs_f64();
-            let rate = *evs as f64 / secs;
+        let rate = |r: &Run| r.events as f64 / r.spent.as_secs_f64();
+        let base = rate(&runs[0]);
+        for r in &runs {
+            let secs = r.spent.as_secs_f64();
             println!(
-                "exact packing {packing} N {n}: load {load:.3} s, {bytes:.0} model bytes a sphere, \
-                 {:.0} ns a sphere-step, {:.3} M events/s (10k rate / this: {:.2}), {:.0} ns an event, \
-                 {} events, escaped {}",
-                secs / (*steps as f64 * *n as f64) * 1e9,
-                rate / 1e6,
-                base / rate,
-                secs / *evs as f64 * 1e9,
-                evs,
-                world.escaped()
+                "exact packing {packing} N {}: load {:.3} s, {:.0} model bytes a sphere, \
+                 {:.0} ns a sphere-step, {:.3} M events/s (10k rate / this: {:.2}), \
+                 {:.0} ns an event, {} events, escaped {}",
+                r.n,
+                r.load,
+                r.bytes,
+                secs / (r.steps as f64 * r.n as f64) * 1e9,
+                rate(r) / 1e6,
+                base / rate(r),
+                secs / r.events as f64 * 1e9,
+                r.events,
+                r.world.escaped()
             );
         }
     }
