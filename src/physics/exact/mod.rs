@@ -251,7 +251,6 @@ impl Exact {
         self.events.clear();
         self.events.resize(n, Event::default());
         self.pending.clear();
-        self.pending.resize(n, (f64::INFINITY, Event::default()));
         let filled: f64 = self
             .bodies
             .iter()
@@ -261,7 +260,10 @@ impl Exact {
             let mut nl = Box::<Neighbours>::default();
             nl.build(&self.bodies, self.size);
             self.broad = Broad::Lists(nl);
+            // Only cells keep a pending event apart from the broad phase's.
+            self.pending = Vec::new();
         } else {
+            self.pending.resize(n, (f64::INFINITY, Event::default()));
             let mut cells = Box::<Cells>::default();
             let per_sphere = self.cells_per_sphere.unwrap_or(cells::CELLS_PER_SPHERE);
             cells.build(&self.bodies, self.size, per_sphere);
