@@ -8,13 +8,25 @@
 //!
 //! `cargo run --release --example scaling -- [rounds] [sorted]`
 //!
+//! `cargo run --release --example scaling -- exact [rounds] [max N]`:
+//! the exact model at 10k, 100k and 1M spheres (up to `max N`), packing
+//! 0.005 and 0.1 (the radius set by N, the box 1, seed 5, as
+//! `ballpit bench --count N --radius R --seed 5`). Per size: the time to
+//! load the spheres (the first advance, a step of 1e-9 s), the model's heap
+//! bytes per sphere, then blocks of steps of 2 ms (100 at 10k, 10 at 100k, 2
+//! at 1M) timed in alternation between the sizes: ns per sphere-step and
+//! events (collisions, crossings, walls, relists, stale) per second, and the
+//! 10k rate over that rate.
+//! `exact-one N packing steps [dt]` runs one size only (for callgrind).
+//!
 //! With `sorted`, both worlds are sorted in space (by cell of the 10k
 //! scene's grid, z then y then x) before every block, outside the timing:
 //! how much a world kept in spatial order for free would buy. The model
 //! itself never reorders the world (the screen, the CSV and the model
 //! comparisons read spheres by index).
+use ballpit::physics::exact::{EventStats, Exact};
 use ballpit::physics::sphere::volume;
-use ballpit::physics::{ModelKind, Serial, World};
+use ballpit::physics::{Model, ModelKind, Serial, World};
 use ballpit::scene::{SceneSpec, build_world};
 use std::time::{Duration, Instant};
 
@@ -44,8 +56,159 @@ fn sort_in_space(world: &mut World, cell: f64) {
         .sort_by_key(|s| (c(s.pos.z) * side + c(s.pos.y)) * side + c(s.pos.x));
 }
 
+/// The exact benchmark's scene: `n` spheres filling `packing` of the unit box.
+fn exact_scene(n: usize, packing: f64) -> World {
+    let radius = (packing / (n as f64 * volume(1.0))).cbrt();
+    build_world(&SceneSpec {
+        count: Some(n),
+        radius: Some(radius),
+        seed: Some(5),
+        ..Default::default()
+    })
+    .expect("scene")
+}
+
+/// The exact runs' step: about 400 events at 10k spheres, packing 0.005.
+const DT_EXACT: f64 = 2e-3;
+
+fn events(s: &EventStats) -> u64 {
+    s.pairs + s.stale + s.walls + s.relists + s.crossings
+}
+
+fn exact_one(args: &[String]) {
+    let num = |k: usize| args.get(k).and_then(|a| a.parse::<f64>().ok());
+    let (n, packing, steps) = (
+        num(0).expect("N") as usize,
+        num(1).expect("packing"),
+        num(2).expect("steps") as u64,
+    );
+    let empty = status_kib("VmRSS");
+    let mut world = exact_scene(n, packing);
+    let (scene_peak, scene_rss) = (status_kib("VmHWM"), status_kib("VmRSS"));
+    let mut model = Exact::default();
+    let start = Instant::now();
+    model.advance(&mut world, 1e-9, 1, &Serial);
+    let load = start.elapsed();
+    let e0 = events(&model.stats);
+    let start = Instant::now();
+    // By default a step holds about 400 events whatever N (packing 0.005).
+    let dt = num(3).unwrap_or(1e-3 * 10_000.0 / n as f64);
+    model.advance(&mut world, dt, steps, &Serial);
+    let secs = start.elapsed().as_secs_f64();
+    let ev = events(&model.stats) - e0;
+    let per = |kib: u64| (kib.saturating_sub(empty) * 1024) as f64 / n.max(1) as f64;
+    println!(
+        "{n} spheres, packing {packing}: load {:.3} s, model heap {} bytes a sphere; \
+         RSS a sphere: {:.0} after the scene (peak {:.0}), {:.0} after the steps (peak {:.0}); \
+         {ev} events, {:.3} M/s ({:?})",
+        load.as_secs_f64(),
+        model.heap_bytes() / n.max(1),
+        per(scene_rss),
+        per(scene_peak),
+        per(status_kib("VmRSS")),
+        per(status_kib("VmHWM")),
+        ev as f64 / secs / 1e6,
+        model.stats
+    );
+}
+
+/// A `kB` field of /proc/self/status (0 where there is none).
+fn status_kib(field: &str) -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|t| {
+            let line = t.lines().find(|l| l.starts_with(field))?.to_owned();
+            line.split_whitespace().nth(1)?.parse().ok()
+        })
+        .unwrap_or(0)
+}
+
+/// One size of the exact runs and what its timed blocks add up to.
+struct Run {
+    n: usize,
+    world: World,
+    model: Exact,
+    /// Steps a timed block.
+    block: u64,
+    load: f64,
+    bytes: f64,
+    spent: Duration,
+    events: u64,
+    steps: u64,
+}
+
+fn exact_scaling(args: &[String]) {
+    let rounds: usize = args.first().map_or(5, |r| r.parse().expect("rounds"));
+    let max: usize = args.get(1).map_or(1_000_000, |m| m.parse().expect("max N"));
+    let sizes: Vec<usize> = [10_000, 100_000, 1_000_000]
+        .into_iter()
+        .filter(|&n| n <= max)
+        .collect();
+    for packing in [0.005, 0.1] {
+        let mut runs = Vec::new();
+        for &n in &sizes {
+            let mut world = exact_scene(n, packing);
+            let mut model = Exact::default();
+            let start = Instant::now();
+            model.advance(&mut world, 1e-9, 1, &Serial);
+            let load = start.elapsed().as_secs_f64();
+            let bytes = model.heap_bytes() as f64 / n as f64;
+            runs.push(Run {
+                n,
+                world,
+                model,
+                // The same dt at every size, so the per-step work outside
+                // the event loop (checking and writing back the world,
+                // linear in N) stays a small share; fewer steps as N grows.
+                block: (1_000_000 / n as u64).max(2),
+                load,
+                bytes,
+                spent: Duration::ZERO,
+                events: 0,
+                steps: 0,
+            });
+        }
+        for _ in 0..rounds {
+            for r in &mut runs {
+                // Untimed: the caches after the other sizes.
+                r.model.advance(&mut r.world, DT_EXACT, 1, &Serial);
+                let e0 = events(&r.model.stats);
+                let start = Instant::now();
+                r.model.advance(&mut r.world, DT_EXACT, r.block, &Serial);
+                r.spent += start.elapsed();
+                r.events += events(&r.model.stats) - e0;
+                r.steps += r.block;
+            }
+        }
+        let rate = |r: &Run| r.events as f64 / r.spent.as_secs_f64();
+        let base = rate(&runs[0]);
+        for r in &runs {
+            let secs = r.spent.as_secs_f64();
+            println!(
+                "exact packing {packing} N {}: load {:.3} s, {:.0} model bytes a sphere, \
+                 {:.0} ns a sphere-step, {:.3} M events/s (10k rate / this: {:.2}), \
+                 {:.0} ns an event, {} events, escaped {}",
+                r.n,
+                r.load,
+                r.bytes,
+                secs / (r.steps as f64 * r.n as f64) * 1e9,
+                rate(r) / 1e6,
+                base / rate(r),
+                secs / r.events as f64 * 1e9,
+                r.events,
+                r.world.escaped()
+            );
+        }
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    match args.first().map(String::as_str) {
+        Some("exact") => return exact_scaling(&args[1..]),
+        Some("exact-one") => return exact_one(&args[1..]),
+        _ => {}
+    }
     let sorted = args.iter().any(|a| a == "sorted");
     let rounds: usize = args
         .iter()

@@ -34,6 +34,14 @@ impl CellList {
         self.cell[i]
     }
 
+    /// Bytes held on the heap.
+    pub fn heap_bytes(&self) -> usize {
+        [&self.head, &self.next, &self.prev, &self.cell]
+            .iter()
+            .map(|v| v.capacity() * 4)
+            .sum()
+    }
+
     pub fn insert(&mut self, i: usize, c: usize) {
         self.cell[i] = c as u32;
         self.prev[i] = NONE;

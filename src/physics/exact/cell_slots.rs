@@ -4,8 +4,10 @@
 //! fixed-size copy. Walking a linked list instead ends each cell with a
 //! data-dependent branch (how many spheres?) that mispredicts about once per
 //! cell, which measured as the largest cost of a prediction. The rare
-//! spheres beyond [`BLOCK`] in one cell wait in that cell's overflow list.
+//! spheres beyond [`BLOCK`] in one cell wait in a map from the cell, so a
+//! cell costs its 16-byte block and nothing more.
 use super::cell_list::NONE;
+use std::collections::HashMap;
 
 /// Spheres a cell's block holds (cells are about a diameter wide, so most
 /// hold fewer).
@@ -13,12 +15,10 @@ pub const BLOCK: usize = 3;
 
 #[derive(Clone, Debug, Default)]
 pub struct CellSlots {
-    /// Per cell: the first `BLOCK` spheres, then the count; padded with
-    /// empty cells to a power of two, so a stencil's index can be masked
-    /// instead of checked.
+    /// Per cell: the first `BLOCK` spheres, then the count.
     blocks: Vec<[u32; BLOCK + 1]>,
-    /// Per cell: spheres `BLOCK..count` (empty almost always).
-    overflow: Vec<Vec<u32>>,
+    /// Spheres `BLOCK..count` of the cells holding more than `BLOCK`.
+    overflow: HashMap<u32, Vec<u32>>,
     /// Each sphere's cell (`NONE` for one in no cell) and place in it.
     at: Vec<(u32, u32)>,
 }
@@ -29,10 +29,17 @@ impl CellSlots {
         self.at.clear();
         self.at.resize(spheres, (NONE, NONE));
         self.blocks.clear();
-        self.blocks
-            .resize(cells.next_power_of_two(), [0; BLOCK + 1]);
+        self.blocks.resize(cells, [0; BLOCK + 1]);
         self.overflow.clear();
-        self.overflow.resize(cells, Vec::new());
+    }
+
+    /// Bytes held on the heap.
+    pub fn heap_bytes(&self) -> usize {
+        let over: usize = self.overflow.values().map(|v| v.capacity() * 4 + 32).sum();
+        self.blocks.capacity() * size_of::<[u32; BLOCK + 1]>()
+            + self.at.capacity() * size_of::<(u32, u32)>()
+            + self.overflow.capacity() * (size_of::<(u32, Vec<u32>)>() + 1)
+            + over
     }
 
     #[inline]
@@ -45,7 +52,7 @@ impl CellSlots {
         if k < BLOCK {
             self.blocks[c][k] = j;
         } else {
-            let o = &mut self.overflow[c];
+            let o = self.overflow.entry(c as u32).or_default();
             if k - BLOCK == o.len() {
                 o.push(j);
             } else {
@@ -60,7 +67,7 @@ impl CellSlots {
         if k < BLOCK {
             self.blocks[c][k]
         } else {
-            self.overflow[c][k - BLOCK]
+            self.overflow[&(c as u32)][k - BLOCK]
         }
     }
 
@@ -81,8 +88,12 @@ impl CellSlots {
             let moved = self.get(c, last);
             self.set(c, k, moved);
         }
-        if last >= BLOCK {
-            self.overflow[c].pop();
+        if last == BLOCK {
+            self.overflow.remove(&(c as u32));
+        } else if last > BLOCK
+            && let Some(o) = self.overflow.get_mut(&(c as u32))
+        {
+            o.pop();
         }
         self.blocks[c][BLOCK] -= 1;
         self.at[i] = (NONE, NONE);
@@ -135,7 +146,9 @@ impl CellSlots {
         if counts as usize > BLOCK {
             out.truncate(n);
             for &o in offsets {
-                out.extend_from_slice(&self.overflow[base + o]);
+                if let Some(more) = self.overflow.get(&((base + o) as u32)) {
+                    out.extend_from_slice(more);
+                }
             }
             n = out.len();
         }
@@ -146,8 +159,7 @@ impl CellSlots {
 impl CellSlots {
     /// [`Self::gather`] for a stencil of a fixed `K` cells (the 27 around a
     /// cell, the 9 a crossing brings), all within the grid: per cell one
-    /// masked index, one 16-byte copy and two adds, no clamp and no bounds
-    /// check. A count over `BLOCK` anywhere falls back to [`Self::gather`].
+    /// index, one 16-byte copy and two adds, no clamp. A count over `BLOCK` anywhere falls back to [`Self::gather`].
     #[inline(always)]
     pub fn gather_stencil<const K: usize>(
         &self,
@@ -162,14 +174,13 @@ impl CellSlots {
         let window: &mut [u32; WINDOW + BLOCK + 1] = (&mut out[..WINDOW + BLOCK + 1])
             .try_into()
             .expect("room made above");
-        let blocks = &self.blocks[..];
-        // A power of two (see `reset`); the mask never bites for cells in
-        // the grid.
-        let mask = blocks.len() - 1;
+        // One bounds check per cell remains, never taken (a cell in the
+        // grid has its stencil in the grid, padding included).
+        let blocks = &self.blocks[base..];
         let mut n = 0;
         let mut counts = 0;
         for &o in offsets {
-            let b = &blocks[(base + o) & mask];
+            let b = &blocks[o];
             // Each count is at most BLOCK on this path, so `n` stays within
             // the window; the mask only lets the compiler see that.
             let at = n & (WINDOW - 1);

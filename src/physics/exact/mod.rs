@@ -126,6 +126,7 @@ pub struct Exact {
     synced_time: f64,
     valid: bool,
     cap: Option<u64>,
+    cells_per_sphere: Option<u32>,
     observer: Option<Observer>,
     /// Events processed since construction, by kind.
     pub stats: EventStats,
@@ -152,9 +153,32 @@ impl Exact {
         self
     }
 
+    /// Set the most cells per sphere of the cell grid (default
+    /// [`cells::CELLS_PER_SPHERE`]; at least 1), for comparing grids.
+    pub fn with_cells_per_sphere(mut self, k: u32) -> Self {
+        self.cells_per_sphere = Some(k.max(1));
+        self
+    }
+
     /// Call `f` for every sphere–sphere contact.
     pub fn set_observer(&mut self, f: Option<Observer>) {
         self.observer = f;
+    }
+
+    /// Bytes the model holds on the heap (its copy of the spheres, the
+    /// schedule and the broad phase; not the world's own spheres).
+    pub fn heap_bytes(&self) -> usize {
+        let broad = match &self.broad {
+            Broad::Lists(nl) => nl.heap_bytes(),
+            Broad::Cells(cells) => cells.heap_bytes(),
+        };
+        self.bodies.capacity() * size_of::<Body>()
+            + self.mass.capacity() * 8
+            + (self.order.capacity() + self.counts.capacity() + self.candidates.capacity()) * 4
+            + self.events.capacity() * size_of::<Event>()
+            + self.pending.capacity() * size_of::<(f64, Event)>()
+            + self.queue.heap_bytes()
+            + broad
     }
 
     fn event_cap(&self) -> u64 {
@@ -188,10 +212,23 @@ impl Exact {
         let cell = |x: f64| ((x / world.size * side as f64) as usize).min(side - 1);
         let key =
             |p: DVec3| cell(p.x.max(0.0)) + side * (cell(p.y.max(0.0)) + side * cell(p.z.max(0.0)));
+        // A counting sort by cell: linear, and stable (ties in world order),
+        // so the order is the one a stable sort by key gives.
+        let keys: Vec<u32> = world.spheres.iter().map(|s| key(s.pos) as u32).collect();
+        let mut start = vec![0u32; side * side * side + 1];
+        for &k in &keys {
+            start[k as usize + 1] += 1;
+        }
+        for c in 1..start.len() {
+            start[c] += start[c - 1];
+        }
         self.order.clear();
-        self.order.extend(0..n as u32);
-        self.order
-            .sort_by_key(|&k| key(world.spheres[k as usize].pos));
+        self.order.resize(n, 0);
+        for (i, &k) in keys.iter().enumerate() {
+            let at = &mut start[k as usize];
+            self.order[*at as usize] = i as u32;
+            *at += 1;
+        }
         self.bodies.clear();
         self.bodies.extend(
             self.order
@@ -214,7 +251,6 @@ impl Exact {
         self.events.clear();
         self.events.resize(n, Event::default());
         self.pending.clear();
-        self.pending.resize(n, (f64::INFINITY, Event::default()));
         let filled: f64 = self
             .bodies
             .iter()
@@ -224,9 +260,13 @@ impl Exact {
             let mut nl = Box::<Neighbours>::default();
             nl.build(&self.bodies, self.size);
             self.broad = Broad::Lists(nl);
+            // Only cells keep a pending event apart from the broad phase's.
+            self.pending = Vec::new();
         } else {
+            self.pending.resize(n, (f64::INFINITY, Event::default()));
             let mut cells = Box::<Cells>::default();
-            cells.build(&self.bodies, self.size);
+            let per_sphere = self.cells_per_sphere.unwrap_or(cells::CELLS_PER_SPHERE);
+            cells.build(&self.bodies, self.size, per_sphere);
             self.broad = Broad::Cells(cells);
         }
         self.queue.reset(n);

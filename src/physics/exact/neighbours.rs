@@ -184,6 +184,18 @@ pub struct Neighbours {
 }
 
 impl Neighbours {
+    /// Bytes held on the heap.
+    pub fn heap_bytes(&self) -> usize {
+        let l = &self.lists;
+        let big: usize = l.big.iter().map(|b| b.capacity() * size_of::<Link>()).sum();
+        self.centre.capacity() * size_of::<Centre>()
+            + l.flat.capacity() * size_of::<Link>()
+            + (l.len.capacity() + l.slot.capacity() + self.bigs.capacity()) * 4
+            + l.big.capacity() * size_of::<Vec<Link>>()
+            + big
+            + self.cells.heap_bytes()
+    }
+
     /// Lists for every sphere, all centred where the spheres are now.
     pub fn build(&mut self, bodies: &[Body], size: f64) {
         let n = bodies.len();

@@ -51,6 +51,11 @@ fn step(keys: &mut [u64], ids: &mut [u32], mask: usize, k: usize, w: u64) -> u64
 }
 
 impl EventQueue {
+    /// Bytes held on the heap.
+    pub fn heap_bytes(&self) -> usize {
+        self.keys.capacity() * 8 + self.ids.capacity() * 4
+    }
+
     /// A queue for spheres `0..n`, every event at infinity.
     pub fn reset(&mut self, n: usize) {
         self.size = n.next_power_of_two().max(1);
