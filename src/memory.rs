@@ -9,7 +9,7 @@ pub fn sphere_bytes(model: ModelKind) -> u64 {
     match model {
         ModelKind::Discrete => 650,
         ModelKind::Swept => 550,
-        ModelKind::Exact => 1500,
+        ModelKind::Exact => 800,
     }
 }
 
@@ -100,7 +100,7 @@ mod tests {
         assert!(check(1_000_000, Some(ModelKind::Swept), free).is_ok());
         let err = check(10_000_000, Some(ModelKind::Exact), free).unwrap_err();
         assert!(
-            err.starts_with("10000000 spheres would need about 14"),
+            err.starts_with("10000000 spheres would need about 7693 MiB"),
             "{err}"
         );
         assert!(
