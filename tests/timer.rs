@@ -45,7 +45,12 @@ fn physics_seconds_cover_the_physics_threads_cpu() {
         let world = scene(model);
         let settings = Settings {
             model,
-            dt: 1.0 / 60.0,
+            // Long steps: on an idle host the untimed copy of the spheres
+            // for the screen (and the thread's wake-ups) stay a few percent
+            // of a frame, while the old untimed readout detection was 12-48 %
+            // (physics/CPU 0.52 discrete, 0.77 swept, 0.88 exact, measured
+            // by moving it back out of the timer).
+            dt: 1.0 / 15.0,
             tick: 1,
             threading: Threading::Worker,
             threads: 1,
