@@ -361,11 +361,21 @@ fn assert_every_thread_visible(text: &[String], r: &CpuReport, what: &str) {
 }
 
 fn screen(w: u16, h: u16, st: &AppState, r: &CpuReport) -> Terminal<TestBackend> {
-    let (snap, stats) = (snapshot(), stats());
+    screen_with(w, h, st, r, &stats())
+}
+
+fn screen_with(
+    w: u16,
+    h: u16,
+    st: &AppState,
+    r: &CpuReport,
+    stats: &Stats,
+) -> Terminal<TestBackend> {
+    let snap = snapshot();
     let view = View {
         state: st,
         snap: &snap,
-        stats: &stats,
+        stats,
         report: r,
         palette: Palette::C16,
         aspect: 2.0,
@@ -477,22 +487,13 @@ fn help_overlay_fits_at_80x24() {
 
 #[test]
 fn a_slow_link_is_shown_at_80x24_in_place_of_the_render_time() {
-    let st = state();
-    let r = report_for(Threading::Off, 0);
-    let mut stats = stats();
-    stats.link = Some("109ms 16KB/s 5fps mono".into());
-    stats.link_slow = true;
-    let snap = snapshot();
-    let view = View {
-        state: &st,
-        snap: &snap,
-        stats: &stats,
-        report: &r,
-        palette: Palette::C16,
-        aspect: 2.0,
+    let (st, r) = (state(), report_for(Threading::Off, 0));
+    let slow = Stats {
+        link: Some("109ms 16KB/s 5fps mono".into()),
+        link_slow: true,
+        ..stats()
     };
-    let mut raster = Raster::new();
-    let text = rows(&render(80, 24, |f| app::draw(f, &mut raster, &view))).join("\n");
+    let text = rows(&screen_with(80, 24, &st, &r, &slow)).join("\n");
     assert!(
         text.contains("link    109ms 16KB/s 5fps mono 4321 B/fr"),
         "{text}"
@@ -501,13 +502,9 @@ fn a_slow_link_is_shown_at_80x24_in_place_of_the_render_time() {
     // A fast link keeps the render time.
     let fast = Stats {
         link_slow: false,
-        ..stats.clone()
+        ..slow
     };
-    let view = View {
-        stats: &fast,
-        ..view
-    };
-    let text = rows(&render(80, 24, |f| app::draw(f, &mut raster, &view))).join("\n");
+    let text = rows(&screen_with(80, 24, &st, &r, &fast)).join("\n");
     assert!(
         text.contains("render") && !text.contains("16KB/s"),
         "{text}"

@@ -334,9 +334,11 @@ impl Engine {
                     frame.model = m.build();
                 }
                 Command::SetCount(n) => {
-                    // Any model may run next: plan for the hungriest.
-                    let fits = crate::memory::check(n, None, crate::memory::available());
-                    if let (true, Err(e)) = (n > frame.world.spheres.len(), fits) {
+                    // Any model may run next: plan for the hungriest. Only
+                    // growth needs the check (and its read of /proc).
+                    if n > frame.world.spheres.len()
+                        && let Err(e) = crate::memory::check(n, None, crate::memory::available())
+                    {
                         frame.notice = Some(format!("count limit: {e}"));
                         continue;
                     }

@@ -36,22 +36,15 @@ pub const LENGTH_RANGE: (f64, f64) = (1e-40, 1e40);
 /// rounding of a position in the box.
 pub const MIN_RADIUS_REL: f64 = 1e-12;
 
-/// Where a scene value came from, for messages that blame what the user
-/// actually gave: a flag, a key of a scene file, or the preset.
-struct Source<'a> {
-    flag: &'static str,
-    file: Option<&'a str>,
-}
-
-impl Source<'_> {
-    /// `--radius`, `scene.toml: radius`, or `the preset's radius`.
-    fn label(&self, given_as_flag: bool, in_file: bool) -> String {
-        let key = self.flag.trim_start_matches("--");
-        match (given_as_flag, in_file, self.file) {
-            (true, _, _) => self.flag.to_string(),
-            (false, true, Some(f)) => format!("{f}: {key}"),
-            _ => format!("the preset's {key}"),
-        }
+/// Who gave a scene value, for messages that blame what the user actually
+/// gave: `--radius` (the flag), `scene.toml: radius` (a key of the file), or
+/// `the preset's radius`.
+fn label(flag: &str, given_as_flag: bool, file_with_key: Option<&str>) -> String {
+    let key = flag.trim_start_matches("--");
+    match (given_as_flag, file_with_key) {
+        (true, _) => flag.to_string(),
+        (false, Some(file)) => format!("{file}: {key}"),
+        (false, None) => format!("the preset's {key}"),
     }
 }
 
@@ -113,18 +106,13 @@ pub fn build_world_for(spec: &SceneSpec, model: Option<ModelKind>) -> Result<Wor
         (None, spec.clone())
     };
     let file_name = file.as_ref().map(|(n, _)| n.as_str());
-    let from_file = |flag: &'static str, given: bool, in_file: bool| {
-        Source {
-            flag,
-            file: file_name,
-        }
-        .label(given, in_file)
-    };
+    // The file's name when the file set the key.
+    let from = |set: bool| file_name.filter(|_| set);
     let f = file.as_ref().map(|(_, f)| f);
-    let box_label = from_file(
+    let box_label = label(
         "--box",
         spec.size.is_some(),
-        f.is_some_and(|f| f.size.is_some()),
+        from(f.is_some_and(|f| f.size.is_some())),
     );
     let size = merged.size.unwrap_or(1.0);
     length(&box_label, size)?;
@@ -152,20 +140,20 @@ pub fn build_world_for(spec: &SceneSpec, model: Option<ModelKind>) -> Result<Wor
             presets::names()
         );
     };
-    let count_label = from_file(
+    let count_label = label(
         "--count",
         spec.count.is_some(),
-        f.is_some_and(|f| f.count.is_some()),
+        from(f.is_some_and(|f| f.count.is_some())),
     );
-    let radius_label = from_file(
+    let radius_label = label(
         "--radius",
         spec.radius.is_some(),
-        f.is_some_and(|f| f.radius.is_some()),
+        from(f.is_some_and(|f| f.radius.is_some())),
     );
-    let speed_label = from_file(
+    let speed_label = label(
         "--speed",
         spec.speed.is_some(),
-        f.is_some_and(|f| f.speed.is_some()),
+        from(f.is_some_and(|f| f.speed.is_some())),
     );
     let count = merged.count.unwrap_or(preset.count);
     if count > MAX_COUNT {
