@@ -142,7 +142,14 @@ fn bad_input_exits_2_with_one_clear_message() {
             "line 2: velocity [1e200, 0.0, 0.0] is too fast",
         ),
         (vec!["--tick=-1".into()], "--tick"),
-        (vec!["--threads".into(), "0".into()], "--threads must be"),
+        (
+            vec!["--threads".into(), "0".into()],
+            "for '--threads <K>': 0 is not in 1..=256",
+        ),
+        (
+            vec!["--threads".into(), "257".into()],
+            "for '--threads <K>': 257 is not in 1..=256",
+        ),
         (
             vec!["--model".into(), "magic".into()],
             "invalid value 'magic' for '--model <MODEL>'\n  [possible values: discrete, swept, exact]",

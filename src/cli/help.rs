@@ -1,5 +1,6 @@
 //! Help text built from the code's own tables: the bench JSON fields and the
 //! presets.
+use crate::engine::MAX_THREADS;
 use crate::scene::presets::PRESETS;
 
 /// The fields of `bench`'s JSON line, in the order it prints them, with what
@@ -94,4 +95,8 @@ pub(super) fn scene_long_help() -> String {
         s.push_str(&format!("\n  {:<w$}  {}", p.name, p.about));
     }
     s
+}
+
+pub(super) fn threads_help() -> String {
+    format!("Pool threads (1 to {MAX_THREADS}) [default: available cores]")
 }

@@ -8,12 +8,13 @@ pub use help::BENCH_FIELDS;
 pub use values::{ColorArg, MAX_FPS, ModelArg, ThreadingArg};
 
 use crate::bad;
-use crate::engine::Settings;
+use crate::engine::{MAX_THREADS, Settings, default_threads};
 use crate::error::BadInput;
 use crate::scene::SceneSpec;
+use clap::builder::RangedU64ValueParser;
 use clap::parser::ValueSource;
 use clap::{ArgMatches, Args, CommandFactory, FromArgMatches, Parser, Subcommand};
-use help::{bench_after_help, scene_long_help};
+use help::{bench_after_help, scene_long_help, threads_help};
 use std::ffi::OsString;
 use std::path::PathBuf;
 use values::{parse_fps, parse_seconds};
@@ -136,8 +137,9 @@ pub struct RunArgs {
     /// Where the physics runs
     #[arg(long, value_enum, default_value_t = ThreadingArg::Off, value_name = "MODE")]
     pub threading: ThreadingArg,
-    /// Pool threads (1 to 256) [default: available cores]
-    #[arg(long, value_name = "K")]
+    /// Pool threads [default: available cores]
+    #[arg(long, value_name = "K", help = threads_help(),
+          value_parser = RangedU64ValueParser::<usize>::new().range(1..=MAX_THREADS as u64))]
     pub threads: Option<usize>,
 }
 impl Cli {
@@ -199,12 +201,7 @@ impl RunArgs {
         if !(self.dt.is_finite() && self.dt > 0.0) {
             return bad!("--dt must be a finite number > 0, got {}", self.dt);
         }
-        let threads = match self.threads {
-            Some(0) => return bad!("--threads must be at least 1"),
-            Some(k) if k > 256 => return bad!("--threads {k} is more than the 256 ballpit allows"),
-            Some(k) => k,
-            None => std::thread::available_parallelism().map_or(1, |n| n.get()),
-        };
+        let threads = self.threads.unwrap_or_else(default_threads);
         Ok(Settings {
             model: self.model.into(),
             dt: self.dt,

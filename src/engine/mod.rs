@@ -119,11 +119,30 @@ pub enum Command {
 
 /// The default pool size: the cores the system gives us.
 pub fn default_threads() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get())
+    std::thread::available_parallelism().map_or(1, |n| n.get().min(MAX_THREADS))
 }
 
-/// Most pool threads `SetThreads` allows.
+/// Most pool threads `SetThreads` allows (the command line and the keys too).
 pub const MAX_THREADS: usize = 256;
+
+/// The threads a mode puts physics work on, driver first; `off` runs on the
+/// calling thread. In `pool` the frame itself runs on a pool thread (rayon
+/// picks which) while `physics` sleeps until it is done, so only the pool
+/// threads are named. A model that runs on one lane (`exact`) ignores the
+/// executor's lanes, so in `split` it runs on `physics` alone.
+pub fn physics_threads(threading: Threading, threads: usize, model: ModelKind) -> Vec<String> {
+    match threading {
+        Threading::Off => {
+            vec![std::thread::current().name().unwrap_or("main").to_string()]
+        }
+        Threading::Pool => (0..threads).map(|i| format!("pool-{i}")).collect(),
+        Threading::Split if !model.runs_on_one_lane() => std::iter::once("physics")
+            .chain(SPLIT_NAMES)
+            .map(String::from)
+            .collect(),
+        Threading::Worker | Threading::Split => vec!["physics".to_string()],
+    }
+}
 /// Seeds the placement of spheres added by `SetCount`, so runs repeat.
 const EDIT_SEED: u64 = 0x62616c6c70697421;
 
@@ -281,27 +300,11 @@ impl Engine {
             .collect()
     }
 
-    /// The threads the current settings put physics work on, driver first.
-    /// In `pool` the frame itself runs on a pool thread (rayon picks which)
-    /// while `physics` sleeps until it is done, so only the pool threads are
-    /// named. A model that runs one event loop (`exact`) ignores the
-    /// executor's lanes, so in `split` it runs on `physics` alone.
+    /// The threads the current settings put physics work on, driver first
+    /// (see [`physics_threads`]).
     pub fn physics_threads(&self) -> Vec<String> {
-        match self.settings.threading {
-            Threading::Off => {
-                vec![std::thread::current().name().unwrap_or("main").to_string()]
-            }
-            Threading::Pool => (0..self.settings.threads)
-                .map(|i| format!("pool-{i}"))
-                .collect(),
-            Threading::Split if self.settings.model != ModelKind::Exact => {
-                std::iter::once("physics")
-                    .chain(SPLIT_NAMES)
-                    .map(String::from)
-                    .collect()
-            }
-            Threading::Worker | Threading::Split => vec!["physics".to_string()],
-        }
+        let s = &self.settings;
+        physics_threads(s.threading, s.threads, s.model)
     }
 
     fn check(&self) -> anyhow::Result<()> {

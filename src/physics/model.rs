@@ -22,6 +22,12 @@ impl ModelKind {
         }
     }
 
+    /// Whether a step runs as one sequence on one lane, whatever the
+    /// executor offers: `exact` runs one event loop.
+    pub fn runs_on_one_lane(self) -> bool {
+        matches!(self, ModelKind::Exact)
+    }
+
     /// The next model in the `m` key's cycle.
     pub fn next(self) -> ModelKind {
         let i = Self::ALL.iter().position(|&m| m == self).unwrap_or(0);

@@ -1,8 +1,8 @@
 //! The readouts panel: every figure as text in a fixed place, so values
 //! change without the layout moving.
-use super::state::{AppState, physics_threads, representative_radius};
+use super::state::{AppState, representative_radius};
 use super::theme::Palette;
-use crate::engine::{Snapshot, Threading};
+use crate::engine::{Snapshot, Threading, physics_threads};
 use crate::physics::ModelKind;
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
@@ -51,16 +51,16 @@ pub struct Readouts<'a> {
 impl Readouts<'_> {
     fn threading(&self) -> String {
         let s = self.state;
-        let threads = physics_threads(s.threading, s.threads);
+        let threads = physics_threads(s.threading, s.threads, s.model).len();
         match s.threading {
             Threading::Off => format!("off      on main; t -> {}", s.last_threaded),
-            // The event loop of `exact` does not split: say where it runs
-            // (a pool hosts the whole frame on one of its threads).
-            Threading::Pool if s.model == ModelKind::Exact => {
-                format!("{:<8} exact on 1 pool thread", Threading::Pool.name())
+            // A model on one lane does not split: say where it runs (a
+            // pool hosts the whole frame on one of its threads).
+            Threading::Pool if s.model.runs_on_one_lane() => {
+                format!("{:<8} {} on 1 pool thread", Threading::Pool.name(), s.model)
             }
-            Threading::Split if s.model == ModelKind::Exact => {
-                format!("{:<8} exact runs on physics", Threading::Split.name())
+            Threading::Split if s.model.runs_on_one_lane() => {
+                format!("{:<8} {} runs on physics", Threading::Split.name(), s.model)
             }
             t => format!(
                 "{:<8} {threads} physics thread{}",

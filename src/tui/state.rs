@@ -3,11 +3,10 @@
 use super::canvas::{DrawStyle, LIGHT_STEPS};
 use super::input::Action;
 use super::projection::Camera;
-use crate::engine::{Command, Settings, Snapshot, Threading};
+use crate::engine::{Command, MAX_THREADS, Settings, Snapshot, Threading};
 use crate::physics::ModelKind;
 
 pub const MAX_TICK: u32 = 1000;
-pub const MAX_THREADS: usize = 256;
 pub const MAX_COUNT: usize = 1 << 21;
 pub const MIN_RADIUS: f64 = 1e-4;
 pub const RADIUS_STEP: f64 = 1.25;
@@ -124,7 +123,7 @@ impl AppState {
                             "pool threads {want}: kept for pool mode (now {})",
                             self.threading
                         ));
-                    } else if self.model == ModelKind::Exact {
+                    } else if self.model.runs_on_one_lane() {
                         self.notice =
                             Some(format!("pool threads {want}: exact runs on one thread"));
                     }
@@ -246,14 +245,4 @@ impl AppState {
 /// largest sphere is what hits the limit first).
 pub fn representative_radius(snap: &Snapshot) -> Option<f64> {
     snap.spheres.iter().map(|s| s.radius).reduce(f64::max)
-}
-
-/// Physics threads a mode uses, for the readout.
-pub fn physics_threads(threading: Threading, pool: usize) -> usize {
-    match threading {
-        Threading::Off => 0,
-        Threading::Worker => 1,
-        Threading::Pool => pool,
-        Threading::Split => 2,
-    }
 }
