@@ -26,13 +26,16 @@ use crate::physics::{Model, ModelKind, Serial, World, edit};
 use frame::{Frame, SharedExec};
 use rand::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
-use std::fmt;
-use std::str::FromStr;
 use std::sync::Arc;
+use strum::{Display, EnumCount, EnumString, IntoStaticStr};
 use worker::Worker;
 
-/// Where the physics runs (docs/design.md, Threading).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+/// Where the physics runs (docs/design.md, Threading); the names are the
+/// command line's.
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, Display, EnumCount, EnumString, IntoStaticStr,
+)]
+#[strum(serialize_all = "lowercase")]
 pub enum Threading {
     Off,
     Worker,
@@ -41,7 +44,8 @@ pub enum Threading {
 }
 
 impl Threading {
-    pub const ALL: [Threading; 4] = [
+    /// Every mode (a new variant does not compile until it is listed here).
+    pub const ALL: [Threading; Self::COUNT] = [
         Threading::Off,
         Threading::Worker,
         Threading::Pool,
@@ -49,12 +53,7 @@ impl Threading {
     ];
 
     pub fn name(self) -> &'static str {
-        match self {
-            Threading::Off => "off",
-            Threading::Worker => "worker",
-            Threading::Pool => "pool",
-            Threading::Split => "split",
-        }
+        self.into()
     }
 
     /// The `d` key: worker → pool → split → worker (off stays off).
@@ -65,25 +64,6 @@ impl Threading {
             Threading::Pool => Threading::Split,
             Threading::Split => Threading::Worker,
         }
-    }
-}
-
-impl fmt::Display for Threading {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for Threading {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL
-            .iter()
-            .copied()
-            .find(|t| t.name() == s)
-            .ok_or_else(|| {
-                format!("unknown threading '{s}' (expected one of: off, worker, pool, split)")
-            })
     }
 }
 

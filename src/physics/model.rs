@@ -1,10 +1,12 @@
 use super::exec::Exec;
 use super::world::World;
-use std::fmt;
-use std::str::FromStr;
+use strum::{Display, EnumCount, EnumString, IntoStaticStr};
 
-/// The collision models of docs/design.md.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+/// The collision models of docs/design.md; the names are the command line's.
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, Display, EnumCount, EnumString, IntoStaticStr,
+)]
+#[strum(serialize_all = "lowercase")]
 pub enum ModelKind {
     Discrete,
     Swept,
@@ -12,14 +14,13 @@ pub enum ModelKind {
 }
 
 impl ModelKind {
-    pub const ALL: [ModelKind; 3] = [ModelKind::Discrete, ModelKind::Swept, ModelKind::Exact];
+    /// Every model, in the `m` key's cycle (a new variant does not compile
+    /// until it is listed here).
+    pub const ALL: [ModelKind; Self::COUNT] =
+        [ModelKind::Discrete, ModelKind::Swept, ModelKind::Exact];
 
     pub fn name(self) -> &'static str {
-        match self {
-            ModelKind::Discrete => "discrete",
-            ModelKind::Swept => "swept",
-            ModelKind::Exact => "exact",
-        }
+        self.into()
     }
 
     /// Whether a step runs as one sequence on one lane, whatever the
@@ -43,29 +44,6 @@ impl ModelKind {
     }
 }
 
-impl fmt::Display for ModelKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for ModelKind {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL
-            .iter()
-            .copied()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| {
-                let names: Vec<_> = Self::ALL.iter().map(|m| m.name()).collect();
-                format!(
-                    "unknown model '{s}' (expected one of: {})",
-                    names.join(", ")
-                )
-            })
-    }
-}
-
 /// A collision model. It may keep state between calls (schedules, grids); it
 /// must drop what depends on the spheres when `invalidate` is called.
 pub trait Model: Send {
@@ -84,5 +62,31 @@ pub trait Model: Send {
     /// `None` leaves it to the caller.
     fn max_overlap_rel(&mut self, _world: &World, _dt: f64, _exec: &dyn Exec) -> Option<f64> {
         None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_parse_back_and_the_cycle_visits_every_model() {
+        let names: Vec<_> = ModelKind::ALL.map(ModelKind::name).into();
+        assert_eq!(names, ["discrete", "swept", "exact"]);
+        for m in ModelKind::ALL {
+            assert_eq!(m.to_string(), m.name());
+            assert_eq!(m.name().parse(), Ok(m));
+        }
+        assert!("Exact".parse::<ModelKind>().is_err());
+        let mut m = ModelKind::Discrete;
+        let mut seen = Vec::new();
+        for _ in 0..ModelKind::COUNT {
+            m = m.next();
+            seen.push(m);
+        }
+        assert_eq!(
+            seen,
+            [ModelKind::Swept, ModelKind::Exact, ModelKind::Discrete]
+        );
     }
 }

@@ -7,33 +7,34 @@ use crate::engine::SphereView;
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
 use ratatui::style::Color;
+use strum::{EnumIter, IntoEnumIterator, IntoStaticStr};
 
 /// `v` cycles these.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, EnumIter, IntoStaticStr)]
 pub enum DrawStyle {
     /// Braille dots (2×4 per cell), one colour per cell, coloured by speed.
+    #[strum(serialize = "braille, speed")]
     PointsSpeed,
     /// Braille dots coloured by depth (near bright, far dark).
+    #[strum(serialize = "braille, depth")]
     PointsDepth,
     /// Half-blocks (1×2 per cell), each pixel lit by the light.
+    #[strum(serialize = "shaded blocks")]
     Shaded,
 }
 
 impl DrawStyle {
+    /// The `v` key's cycle, in the order of declaration.
     pub fn next(self) -> DrawStyle {
-        match self {
-            DrawStyle::PointsSpeed => DrawStyle::PointsDepth,
-            DrawStyle::PointsDepth => DrawStyle::Shaded,
-            DrawStyle::Shaded => DrawStyle::PointsSpeed,
-        }
+        DrawStyle::iter()
+            .cycle()
+            .skip_while(|&s| s != self)
+            .nth(1)
+            .unwrap_or(self)
     }
 
     pub fn name(self) -> &'static str {
-        match self {
-            DrawStyle::PointsSpeed => "braille, speed",
-            DrawStyle::PointsDepth => "braille, depth",
-            DrawStyle::Shaded => "shaded blocks",
-        }
+        self.into()
     }
 
     fn sub(self) -> (usize, usize) {

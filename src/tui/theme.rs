@@ -3,50 +3,39 @@
 //! wire; 256 and truecolor are opt-in. With no colour, the canvas keeps its
 //! cues in glyphs and the panels in reverse video.
 use ratatui::style::{Color, Modifier, Style};
+use strum::{EnumString, IntoStaticStr};
 
 /// `--color`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, EnumString)]
 pub enum ColorChoice {
     /// 16 colours if the terminal does colour at all; none with `NO_COLOR`.
     #[default]
+    #[strum(serialize = "auto")]
     Auto,
+    #[strum(serialize = "16")]
     C16,
+    #[strum(serialize = "256")]
     C256,
+    #[strum(serialize = "true", serialize = "truecolor", serialize = "24bit")]
     True,
 }
 
-impl std::str::FromStr for ColorChoice {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "auto" => Ok(ColorChoice::Auto),
-            "16" => Ok(ColorChoice::C16),
-            "256" => Ok(ColorChoice::C256),
-            "true" | "truecolor" | "24bit" => Ok(ColorChoice::True),
-            _ => Err(format!(
-                "unknown colour mode '{s}' (expected one of: auto, 16, 256, true)"
-            )),
-        }
-    }
-}
-
 /// What is really drawn with.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, IntoStaticStr)]
 pub enum Palette {
+    #[strum(serialize = "none")]
     Mono,
+    #[strum(serialize = "16")]
     C16,
+    #[strum(serialize = "256")]
     C256,
+    #[strum(serialize = "true")]
     True,
 }
 
 impl Palette {
     pub fn name(self) -> &'static str {
-        match self {
-            Palette::Mono => "none",
-            Palette::C16 => "16",
-            Palette::C256 => "256",
-            Palette::True => "true",
-        }
+        self.into()
     }
 
     /// Resolve `--color` against the environment. An explicit flag wins over
@@ -218,6 +207,27 @@ mod tests {
                 .find(|(n, _)| *n == k)
                 .map(|(_, v)| v.to_string())
         }
+    }
+
+    #[test]
+    fn colour_names_read_and_print_as_the_command_line_writes_them() {
+        for (text, want) in [
+            ("auto", ColorChoice::Auto),
+            ("16", ColorChoice::C16),
+            ("256", ColorChoice::C256),
+            ("true", ColorChoice::True),
+            ("truecolor", ColorChoice::True),
+            ("24bit", ColorChoice::True),
+        ] {
+            assert_eq!(text.parse(), Ok(want), "{text}");
+        }
+        for bad in ["", "Auto", "8", "none"] {
+            assert!(bad.parse::<ColorChoice>().is_err(), "{bad}");
+        }
+        let names: Vec<_> = [Palette::Mono, Palette::C16, Palette::C256, Palette::True]
+            .map(Palette::name)
+            .into();
+        assert_eq!(names, ["none", "16", "256", "true"]);
     }
 
     #[test]
