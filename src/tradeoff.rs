@@ -185,30 +185,50 @@ pub fn markdown(rows: &[Row]) -> String {
     s
 }
 
-pub fn csv(rows: &[Row]) -> String {
-    let mut s = String::from(
-        "model,dt,steps,wall_s_per_sim_s,sphere_steps_per_second,energy_err_rel,max_overlap_rel,escaped,sphere_collisions,missed_rel,horizon_s,pos_err_rms,capped_steps\n",
-    );
+/// The columns of `tradeoff.csv`, in order (`tradeoff --help` lists them).
+pub const CSV_COLUMNS: [&str; 13] = [
+    "model",
+    "dt",
+    "steps",
+    "wall_s_per_sim_s",
+    "sphere_steps_per_second",
+    "energy_err_rel",
+    "max_overlap_rel",
+    "escaped",
+    "sphere_collisions",
+    "missed_rel",
+    "horizon_s",
+    "pos_err_rms",
+    "capped_steps",
+];
+
+/// The rows as CSV. Numbers are in `{:e}` form: one notation for columns
+/// that span many orders of magnitude, each the shortest that reads back.
+pub fn csv(rows: &[Row]) -> anyhow::Result<String> {
+    let mut w = ::csv::Writer::from_writer(Vec::new());
+    w.write_record(CSV_COLUMNS)?;
+    let e = |x: f64| format!("{x:e}");
     for r in rows {
-        let _ = writeln!(
-            s,
-            "{},{:e},{},{:e},{:e},{:e},{:e},{},{},{:e},{:e},{:e},{}",
-            r.model,
-            r.dt,
-            r.steps,
-            r.cost,
-            r.sphere_steps_per_second,
-            r.energy_err,
-            r.max_overlap_rel,
-            r.escaped,
-            r.collisions,
-            r.missed,
-            r.horizon,
-            r.pos_err,
-            r.capped_steps,
-        );
+        // Sized by the header: a column added on one side only does not compile.
+        let fields: [String; CSV_COLUMNS.len()] = [
+            r.model.to_string(),
+            e(r.dt),
+            r.steps.to_string(),
+            e(r.cost),
+            e(r.sphere_steps_per_second),
+            e(r.energy_err),
+            e(r.max_overlap_rel),
+            r.escaped.to_string(),
+            r.collisions.to_string(),
+            e(r.missed),
+            e(r.horizon),
+            e(r.pos_err),
+            r.capped_steps.to_string(),
+        ];
+        w.write_record(&fields)?;
     }
-    s
+    let bytes = w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?;
+    Ok(String::from_utf8(bytes)?)
 }
 
 /// Position error against cost, log–log, a line per model (errors below
@@ -275,9 +295,36 @@ pub fn run(world: World, out: Option<&Path>) -> anyhow::Result<String> {
     let rows = measure(&world);
     if let Some(dir) = out {
         let csv_path = dir.join("tradeoff.csv");
-        std::fs::write(&csv_path, csv(&rows))
+        std::fs::write(&csv_path, csv(&rows)?)
             .with_context(|| format!("cannot write {}", csv_path.display()))?;
         svg(&rows, &dir.join("tradeoff.svg"))?;
     }
     Ok(markdown(&rows))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_has_the_header_and_every_number_in_e_form() {
+        let row = Row {
+            model: ModelKind::Swept,
+            dt: 1.0 / 60.0,
+            steps: 120,
+            cost: 0.5,
+            sphere_steps_per_second: 1.5e6,
+            energy_err: 1e-15,
+            max_overlap_rel: 0.0,
+            escaped: 2,
+            collisions: 42,
+            missed: -0.25,
+            horizon: 0.05,
+            pos_err: 3e-3,
+            capped_steps: 1,
+        };
+        let text = csv(&[row.clone(), row]).unwrap();
+        let line = "swept,1.6666666666666666e-2,120,5e-1,1.5e6,1e-15,0e0,2,42,-2.5e-1,5e-2,3e-3,1";
+        assert_eq!(text, format!("{}\n{line}\n{line}\n", CSV_COLUMNS.join(",")));
+    }
 }

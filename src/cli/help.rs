@@ -2,6 +2,7 @@
 //! presets.
 use crate::engine::MAX_THREADS;
 use crate::scene::presets::PRESETS;
+use crate::tradeoff::CSV_COLUMNS;
 
 /// The fields of `bench`'s JSON line, in the order it prints them, with what
 /// each holds; `bench --help` shows them and a test holds them to the output.
@@ -82,6 +83,14 @@ pub(super) fn bench_after_help() -> String {
     }
     s.push_str("\nExample: ballpit bench --scene dense --model exact --threading pool --steps 600");
     s
+}
+
+pub(super) fn tradeoff_after_help() -> String {
+    format!(
+        "With --out DIR it also writes DIR/tradeoff.csv (columns: {}) and DIR/tradeoff.svg \
+         (position error against cost, one line per model).",
+        CSV_COLUMNS.join(", ")
+    )
 }
 
 pub(super) fn scene_long_help() -> String {

@@ -14,7 +14,7 @@ use crate::scene::SceneSpec;
 use clap::builder::RangedU64ValueParser;
 use clap::parser::ValueSource;
 use clap::{ArgMatches, Args, CommandFactory, FromArgMatches, Parser, Subcommand};
-use help::{bench_after_help, scene_long_help, threads_help};
+use help::{bench_after_help, scene_long_help, threads_help, tradeoff_after_help};
 use std::ffi::OsString;
 use std::path::PathBuf;
 use values::{parse_fps, parse_seconds};
@@ -60,10 +60,7 @@ pub enum Command {
                       simulated second), worst energy error, deepest overlap, escapes, \
                       collisions missed, and the position error at a short horizon. Prints a \
                       markdown table; the table names its reference.",
-        after_help = "With --out DIR it also writes DIR/tradeoff.csv (columns: model, dt, steps, \
-                      wall_s_per_sim_s, sphere_steps_per_second, energy_err_rel, max_overlap_rel, \
-                      escaped, sphere_collisions, missed_rel, horizon_s, pos_err_rms, capped_steps) \
-                      and DIR/tradeoff.svg (position error against cost, one line per model)."
+        after_help = tradeoff_after_help()
     )]
     Tradeoff(TradeoffArgs),
     /// Print a shell completion script, e.g. ballpit completions bash

@@ -1,6 +1,7 @@
 //! Sphere CSV: header `x,y,z,vx,vy,vz,radius,mass`, one sphere a row.
 //! Numbers are written in Rust's shortest round-trip form, so a dump reads
-//! back bit for bit.
+//! back bit for bit (ryu, which csv's serializer uses, writes 3.4e-5 as
+//! 0.000034, hence the strings).
 use super::place::{Overlaps, check_with};
 use crate::error::BadInput;
 use crate::physics::{Sphere, World};
@@ -87,15 +88,15 @@ pub fn parse_with(
     Ok(world)
 }
 
-pub fn write(world: &World, out: &mut impl Write) -> std::io::Result<()> {
-    writeln!(out, "{}", HEADER.join(","))?;
+pub fn write(world: &World, out: &mut impl Write) -> csv::Result<()> {
+    let mut w = csv::Writer::from_writer(out);
+    w.write_record(HEADER)?;
     for s in &world.spheres {
-        writeln!(
-            out,
-            "{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?}",
-            s.pos.x, s.pos.y, s.pos.z, s.vel.x, s.vel.y, s.vel.z, s.radius, s.mass
-        )?;
+        let (p, v) = (s.pos, s.vel);
+        let fields = [p.x, p.y, p.z, v.x, v.y, v.z, s.radius, s.mass].map(|x| format!("{x:?}"));
+        w.write_record(&fields)?;
     }
+    w.flush()?;
     Ok(())
 }
 
@@ -120,7 +121,7 @@ impl DumpFile {
     pub fn write(self, world: &World) -> Result<(), BadInput> {
         let mut w = std::io::BufWriter::new(self.file);
         write(world, &mut w)
-            .and_then(|_| w.flush())
+            .and_then(|()| w.flush().map_err(csv::Error::from))
             .map_err(|e| bad_input!("cannot write {}: {e}", self.path.display()))
     }
 }
