@@ -2,9 +2,6 @@
 //! systems get empty answers).
 use std::fs;
 
-/// The kernel's clock tick for `stat` times; 100 on every Linux we target.
-const TICKS_PER_SECOND: f64 = 100.0;
-
 /// `(tid, name, cpu_seconds)` for every thread of the process, by tid. The
 /// main thread (tid = pid) carries the program's name in the kernel; it is
 /// listed as `main`, the name the article and the screen use for it.
@@ -44,7 +41,13 @@ pub fn thread_cpu_seconds_of(tid: i32) -> Option<f64> {
 
 /// utime + stime out of a `stat` line, in seconds.
 pub fn stat_cpu_seconds(stat: &str) -> Option<f64> {
-    Some(super::machine::stat_ticks(stat)? as f64 / TICKS_PER_SECOND)
+    Some(super::machine::stat_ticks(stat)? as f64 / ticks_per_second())
+}
+
+/// The kernel's clock tick for `stat` times (`sysconf(_SC_CLK_TCK)`, from
+/// the auxiliary vector).
+fn ticks_per_second() -> f64 {
+    rustix::param::clock_ticks_per_second().max(1) as f64
 }
 
 /// The calling thread's id (Linux), from `/proc/thread-self`.
@@ -60,6 +63,14 @@ mod tests {
     #[test]
     fn stat_fields_after_odd_names() {
         let line = "42 (a) b (c)) R 1 1 1 0 -1 4194304 132 0 0 0 250 130 0 0 20 0 1 0";
-        assert_eq!(stat_cpu_seconds(line), Some(3.8));
+        assert_eq!(stat_cpu_seconds(line), Some(380.0 / ticks_per_second()));
+    }
+
+    #[test]
+    fn the_clock_tick_is_the_kernels() {
+        // USER_HZ is 100 on the Linux builds we know of; the test says so
+        // if a kernel reports another (then the old constant was wrong).
+        #[cfg(target_os = "linux")]
+        assert_eq!(ticks_per_second(), 100.0);
     }
 }
