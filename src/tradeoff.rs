@@ -18,10 +18,13 @@
 //! collisions per sphere any two runs differ by the box.
 use crate::physics::{ModelKind, Serial, World, reference};
 use anyhow::Context;
+use indicatif::{ProgressBar, ProgressStyle};
 use plotters::prelude::*;
 use std::fmt::Write as _;
+use std::io::IsTerminal;
 use std::path::Path;
 use std::time::Instant;
+use strum::EnumCount;
 
 /// The `dt` ladder: 1/15 s down to 1/1920 s, halving.
 pub const LADDER: [f64; 8] = [
@@ -57,8 +60,24 @@ pub struct Row {
     pub capped_steps: u64,
 }
 
+/// The runs [`measure`] makes: the reference over [`RUN_SECONDS`] and to
+/// each dt's horizon, then per model and dt a run and a run to the horizon.
+pub const RUNS: usize = 1 + LADDER.len() + 2 * ModelKind::COUNT * LADDER.len();
+
 /// Measure every model over the ladder on `world`.
 pub fn measure(world: &World) -> Vec<Row> {
+    measure_with(world, &mut |_, _| {})
+}
+
+/// [`measure`], calling `progress(done, next)` before each of its [`RUNS`]
+/// runs with the number done so far and what runs next.
+pub fn measure_with(world: &World, progress: &mut dyn FnMut(usize, &str)) -> Vec<Row> {
+    let mut done = 0;
+    let mut next = |what: &str| {
+        progress(done, what);
+        done += 1;
+    };
+    next("reference");
     let reference = {
         let mut w = world.clone();
         reference::run(&mut w, RUN_SECONDS);
@@ -75,6 +94,7 @@ pub fn measure(world: &World) -> Vec<Row> {
     let at_horizon: Vec<(u64, World)> = LADDER
         .iter()
         .map(|&dt| {
+            next(&format!("reference to the horizon, dt {}", dt_label(dt)));
             let steps = (horizon / dt).ceil().max(1.0) as u64;
             let mut w = world.clone();
             reference::run(&mut w, steps as f64 * dt);
@@ -84,12 +104,14 @@ pub fn measure(world: &World) -> Vec<Row> {
     let mut rows = Vec::new();
     for model in ModelKind::ALL {
         for (dt, (steps_h, truth)) in LADDER.into_iter().zip(&at_horizon) {
+            next(&format!("{model}, dt {}", dt_label(dt)));
             let mut row = run_one(world, model, dt);
             row.missed = if reference > 0 {
                 1.0 - row.collisions as f64 / reference as f64
             } else {
                 0.0
             };
+            next(&format!("{model} to the horizon, dt {}", dt_label(dt)));
             row.pos_err = position_error(world, model, dt, *steps_h, truth);
             row.horizon = *steps_h as f64 * dt;
             rows.push(row);
@@ -292,7 +314,12 @@ pub fn run(world: World, out: Option<&Path>) -> anyhow::Result<String> {
             crate::error::BadInput(format!("cannot create directory {}: {e}", dir.display()))
         })?;
     }
-    let rows = measure(&world);
+    let bar = progress_bar();
+    let rows = measure_with(&world, &mut |done, next| {
+        bar.set_position(done as u64);
+        bar.set_message(next.to_string());
+    });
+    bar.finish_and_clear();
     if let Some(dir) = out {
         let csv_path = dir.join("tradeoff.csv");
         std::fs::write(&csv_path, csv(&rows)?)
@@ -302,9 +329,25 @@ pub fn run(world: World, out: Option<&Path>) -> anyhow::Result<String> {
     Ok(markdown(&rows))
 }
 
+/// Runs done, on stderr when it is a terminal; hidden in pipes and tests,
+/// where it would only add noise to what is read.
+fn progress_bar() -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(RUNS as u64);
+    // The template is a constant: it either parses or fails here alike.
+    if let Ok(style) = ProgressStyle::with_template("{bar:20} {pos}/{len} runs, {elapsed}: {msg}") {
+        bar.set_style(style);
+    }
+    bar
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::physics::Sphere;
+    use glam::DVec3;
 
     #[test]
     fn csv_has_the_header_and_every_number_in_e_form() {
@@ -326,5 +369,27 @@ mod tests {
         let text = csv(&[row.clone(), row]).unwrap();
         let line = "swept,1.6666666666666666e-2,120,5e-1,1.5e6,1e-15,0e0,2,42,-2.5e-1,5e-2,3e-3,1";
         assert_eq!(text, format!("{}\n{line}\n{line}\n", CSV_COLUMNS.join(",")));
+    }
+
+    #[test]
+    fn progress_counts_every_run_once_in_order() {
+        let spheres = (0..4)
+            .map(|i| Sphere {
+                pos: DVec3::new(0.2 + 0.2 * f64::from(i), 0.5, 0.5),
+                vel: DVec3::new(0.3, -0.2 * f64::from(i), 0.1),
+                radius: 0.05,
+                mass: 1.0,
+            })
+            .collect();
+        let world = World::new(1.0, spheres);
+        let mut seen = Vec::new();
+        let rows = measure_with(&world, &mut |done, next| {
+            seen.push((done, next.to_string()))
+        });
+        assert_eq!(rows.len(), ModelKind::COUNT * LADDER.len());
+        assert_eq!(seen.len(), RUNS);
+        assert!(seen.iter().enumerate().all(|(i, (done, _))| *done == i));
+        assert_eq!(seen[0].1, "reference");
+        assert_eq!(seen[RUNS - 1].1, "exact to the horizon, dt 1/1920");
     }
 }

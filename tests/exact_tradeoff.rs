@@ -146,6 +146,8 @@ fn cli_writes_the_table_the_csv_and_the_plot() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    // The progress bar is for terminals only: nothing on a piped stderr.
+    assert_eq!(String::from_utf8_lossy(&out.stderr), "");
     let table = String::from_utf8(out.stdout).unwrap();
     // The note naming the reference, a blank line, the header, the rows.
     assert_eq!(table.lines().next(), Some(REFERENCE_NOTE));
