@@ -3,25 +3,13 @@ use ballpit::cli::{Cli, Command};
 use ballpit::error::BadInput;
 use ballpit::{bench, scene};
 use clap::CommandFactory;
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
     // clap prints its own message and exits with 2 on a usage error (0 for --help).
     let cli = Cli::try_parse_checked(std::env::args_os()).unwrap_or_else(|e| e.exit());
-    match run(cli) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            if let Some(bad) = e.downcast_ref::<BadInput>() {
-                // stderr may be gone with the terminal: never panic for it.
-                let _ = writeln!(std::io::stderr(), "ballpit: {bad}");
-                ExitCode::from(2)
-            } else {
-                let _ = writeln!(std::io::stderr(), "ballpit: {e:#}");
-                ExitCode::FAILURE
-            }
-        }
-    }
+    ballpit::error::exit_code(run(cli))
 }
 
 /// Write `bytes` to stdout; a full disk or a closed pipe is reported, not a panic.
@@ -76,24 +64,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             clap_mangen::Man::new(Cli::command()).render(&mut page)?;
             Ok(emit(&page)?)
         }
-        None => {
-            // Flags, then the terminal, then the scene: nothing is built for
-            // a screen that cannot open.
-            let settings = cli.run.settings()?;
-            let opts = cli.options();
-            if !(std::io::stdin().is_terminal() && std::io::stdout().is_terminal()) {
-                return Err(BadInput(
-                    "ballpit's screen needs a terminal, but stdin or stdout is not one; \
-                     for a headless run use `ballpit bench`"
-                        .into(),
-                )
-                .into());
-            }
-            let world = scene::build_world_for(&cli.scene.spec(), Some(settings.model))?;
-            // The app can switch to any model: plan for the hungriest.
-            fits(world.spheres.len(), None)?;
-            ballpit::tui::run(world, settings, opts)
-        }
+        None => cli.run_screen(None),
     }
 }
 

@@ -180,9 +180,19 @@ fn a_panic_in_another_thread_restores_the_terminal_then_prints_and_fails() {
             pixel_height: 0,
         })
         .unwrap();
-    let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_ballpit"));
+    // The app with a thread that panics after the first frame: an example,
+    // so the shipped binary carries no test hook. `cargo test` builds it
+    // next to the binary.
+    let probe = std::path::Path::new(env!("CARGO_BIN_EXE_ballpit"))
+        .with_file_name("examples")
+        .join("panic_probe");
+    assert!(
+        probe.exists(),
+        "{} is missing: run the whole `cargo test` (or `cargo build --examples` first)",
+        probe.display()
+    );
+    let mut cmd = CommandBuilder::new(probe);
     cmd.env("TERM", "xterm-256color");
-    cmd.env("BALLPIT_TEST_PANIC_THREAD", "1");
     cmd.env("RUST_BACKTRACE", "0");
     let mut child = pty.slave.spawn_command(cmd).unwrap();
     drop(pty.slave);

@@ -2,6 +2,7 @@
 //! of `values.rs` mirror the domain's (models, threading modes, colours) so
 //! physics/ and engine/ never see clap.
 mod help;
+mod screen;
 mod values;
 
 pub use help::BENCH_FIELDS;

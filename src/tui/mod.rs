@@ -24,7 +24,7 @@ pub mod theme;
 pub mod threads;
 pub mod writer;
 
-pub use run::run;
+pub use run::{AfterFirstFrame, run, run_with};
 pub use theme::ColorChoice;
 
 /// What the command line sets for the screen.

@@ -25,8 +25,22 @@ use std::time::{Duration, Instant};
 /// Per-thread CPU is sampled once a second: a minute of history is 60 bars.
 const SAMPLE_PERIOD: Duration = Duration::from_secs(1);
 
+/// Called once on the frame loop's thread when the first frame has gone to
+/// the terminal (examples/panic_probe.rs uses it; the app passes none).
+pub type AfterFirstFrame = Box<dyn FnOnce()>;
+
 /// Open the screen on `world` and run until the user quits.
 pub fn run(world: World, settings: Settings, opts: Options) -> anyhow::Result<()> {
+    run_with(world, settings, opts, None)
+}
+
+/// [`run`], calling `after_first_frame` once the first frame is out.
+pub fn run_with(
+    world: World,
+    settings: Settings,
+    opts: Options,
+    after_first_frame: Option<AfterFirstFrame>,
+) -> anyhow::Result<()> {
     if !(opts.fps.is_finite() && opts.fps > 0.0 && opts.fps <= 1000.0) {
         return Err(BadInput(format!(
             "--fps must be greater than 0 and at most 1000, got {}",
@@ -60,16 +74,10 @@ pub fn run(world: World, settings: Settings, opts: Options) -> anyhow::Result<()
     let guard = Guard::enter(tx.clone()).context("cannot set up the terminal")?;
     let signals = guard::spawn_signals(tx.clone())?;
     reader::spawn_input(tx.clone())?;
-    // For the end-to-end test of a panic off the main thread.
-    if std::env::var_os("BALLPIT_TEST_PANIC_THREAD").is_some() {
-        std::thread::Builder::new()
-            .name("test-panic".into())
-            .spawn(|| {
-                std::thread::sleep(Duration::from_millis(300));
-                panic!("test panic in a worker thread");
-            })?;
-    }
-    let mut result = FrameLoop::new(engine, state, palette, detected, tx).and_then(|l| l.run(rx));
+    let mut result = FrameLoop::new(engine, state, palette, detected, tx).and_then(|mut l| {
+        l.after_first_frame = after_first_frame;
+        l.run(rx)
+    });
     // A panic restores the terminal, so the frame loop may stop on a refused
     // write first: the panic is the reason to report.
     if result.is_err() && guard::panicked() {
@@ -110,6 +118,7 @@ struct FrameLoop {
     /// Something on screen would change.
     dirty: bool,
     window: Window,
+    after_first_frame: Option<AfterFirstFrame>,
 }
 
 /// Counts over the current one-second window for the per-second figures.
@@ -175,6 +184,7 @@ impl FrameLoop {
                 collisions_at_start: collisions,
                 ..Window::default()
             },
+            after_first_frame: None,
         })
     }
 
@@ -354,6 +364,9 @@ impl FrameLoop {
             return Err(anyhow!("the output thread stopped"));
         }
         self.pacer.sent(Instant::now(), len, asked);
+        if let Some(hook) = self.after_first_frame.take() {
+            hook();
+        }
         self.window.render_seconds += t0.elapsed().as_secs_f64();
         self.window.bytes += self.bytes.load(Ordering::Relaxed) - before;
         self.window.frames += 1;
