@@ -5,6 +5,7 @@
 //!
 //! `cargo bench --bench engine` (criterion; a phase breakdown is printed
 //! first).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap fails the run
 use ballpit::cpu::CpuReport;
 use ballpit::engine::{Engine, Settings, Snapshot, Threading};
 use ballpit::physics::broad::Grid;
@@ -100,7 +101,7 @@ impl Exec for SerialJoin {
         1
     }
     fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
-        f(0)
+        f(0);
     }
     fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {
         let t0 = cpu_now();
@@ -138,6 +139,7 @@ fn clusters(w: &World) -> (usize, usize, usize, usize) {
     };
     grid.pairs(&Serial, &meets, &mut pairs);
     let mut parent: Vec<usize> = (0..w.spheres.len()).collect();
+    #[allow(clippy::items_after_statements)] // next to its one use
     fn root(p: &mut [usize], mut i: usize) -> usize {
         while p[i] != i {
             p[i] = p[p[i]];
@@ -288,7 +290,7 @@ fn bench_pool(c: &mut Criterion, label: &str, world: &World) {
             b.iter(|| {
                 e.start_frame().unwrap();
                 black_box(e.finish_frame().unwrap().energy);
-            })
+            });
         });
     }
     g.finish();
@@ -572,7 +574,7 @@ fn tui_pipelining(c: &mut Criterion) {
                 e.start_frame().unwrap();
                 draw.draw(e.snapshot());
                 e.finish_frame().unwrap();
-            })
+            });
         });
     }
     g.finish();

@@ -2,6 +2,7 @@
 //! core at N = 4000, packing 0.05, 0.25 and 0.45 (lattice start, melted
 //! before timing). `cargo bench --bench exact`; the accuracy figures (energy
 //! drift over 10 million collisions, deepest overlap, escapes) print first.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap fails the run
 use ballpit::physics::exact::Exact;
 use ballpit::physics::exact::lattice;
 use ballpit::physics::{Model, Serial, World};
@@ -67,7 +68,7 @@ fn throughput(c: &mut Criterion) {
                     assert_eq!(w.counters.sphere_collisions, probe);
                 }
                 total
-            })
+            });
         });
     }
     g.finish();

@@ -6,6 +6,7 @@
 //!   from the thread's schedstat, for shared machines.
 //! - then prints bytes per second at 120×40 for the default scene at 30 fps,
 //!   in 16 colours (target < 150 KB/s) and in truecolor.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap fails the run
 use ballpit::cpu::CpuReport;
 use ballpit::engine::{Engine, Settings, Snapshot, Threading};
 use ballpit::physics::{ModelKind, Sphere, World};
@@ -113,7 +114,7 @@ fn bench_view(c: &mut Criterion, id: &str, st: &AppState, snaps: &[Snapshot]) {
                 aspect: 2.0,
             };
             frame(&mut t, &mut raster, &view);
-        })
+        });
     });
 }
 
@@ -135,7 +136,7 @@ fn bench_frame(c: &mut Criterion) {
 
 /// Bytes written per second at 120×40, default scene, 30 fps, 3 seconds.
 fn wire_bytes() {
-    let default_scene = ballpit::scene::build_world(&Default::default()).unwrap();
+    let default_scene = ballpit::scene::build_world(&ballpit::scene::SceneSpec::default()).unwrap();
     let snaps = frames(default_scene, 90);
     for (palette, style) in [
         (Palette::C16, DrawStyle::PointsSpeed),

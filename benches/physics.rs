@@ -1,6 +1,7 @@
 //! Step throughput, one thread, `swept` (and `discrete` for comparison):
 //! N = 1k, 10k, 100k at packing fractions 0.005 and 0.1. Throughput is in
 //! sphere-steps per second (criterion's "elem/s").
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap fails the run
 use ballpit::physics::sphere::volume;
 use ballpit::physics::{ModelKind, Serial};
 use ballpit::scene::{SceneSpec, build_world};
@@ -36,7 +37,7 @@ fn step_throughput(c: &mut Criterion) {
                 let mut m = model.build();
                 group.throughput(Throughput::Elements(n as u64));
                 group.bench_function(BenchmarkId::new(format!("{model}/phi{phi}"), n), |b| {
-                    b.iter(|| m.advance(&mut world, 1.0 / 60.0, 1, &Serial))
+                    b.iter(|| m.advance(&mut world, 1.0 / 60.0, 1, &Serial));
                 });
             }
         }
@@ -69,7 +70,7 @@ fn same_spheres(c: &mut Criterion) {
         let mut m = ModelKind::Swept.build();
         group.throughput(Throughput::Elements(n as u64));
         group.bench_function(BenchmarkId::new("swept/phi0.005", n), |b| {
-            b.iter(|| m.advance(&mut world, 1.0 / 60.0, 1, &Serial))
+            b.iter(|| m.advance(&mut world, 1.0 / 60.0, 1, &Serial));
         });
     }
     group.finish();

@@ -4,6 +4,7 @@
 //! counts only the event loop; divide by the collisions printed).
 //!
 //! `cargo run --release --example exact_rate -- 0.25 400000`
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap fails the run
 use ballpit::physics::exact::lattice::melted;
 use ballpit::physics::{Model, Serial};
 use std::time::Instant;

@@ -4,6 +4,7 @@
 //! a little serial work between sections as a step has.
 //!
 //! `cargo run --release --example handoff`
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap fails the run
 use ballpit::engine::PoolExec;
 use ballpit::physics::Exec;
 use std::hint::black_box;
@@ -11,7 +12,7 @@ use std::time::Instant;
 
 fn serial_work(n: u64) -> u64 {
     (0..n).fold(1u64, |a, x| {
-        black_box(a.wrapping_mul(6364136223846793005).wrapping_add(x))
+        black_box(a.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(x))
     })
 }
 

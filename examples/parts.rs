@@ -5,6 +5,7 @@
 //! process's: run it under `/usr/bin/time -v`.
 //!
 //! `cargo run --release --example parts -- projectiles 3000 5 [whole|auto|K] [radius]`
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap fails the run
 use ballpit::physics::swept::Swept;
 use ballpit::physics::{Model, Serial};
 use ballpit::scene::{SceneSpec, build_world};

@@ -24,6 +24,7 @@
 //! how much a world kept in spatial order for free would buy. The model
 //! itself never reorders the world (the screen, the CSV and the model
 //! comparisons read spheres by index).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap fails the run
 use ballpit::physics::exact::{EventStats, Exact};
 use ballpit::physics::sphere::volume;
 use ballpit::physics::{Model, ModelKind, Serial, World};

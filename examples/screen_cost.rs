@@ -1,6 +1,6 @@
 //! What drawing the screen costs the frame loop, by size, thread count and
 //! view: the default scene's snapshot and a made-up CPU report with a
-//! minute of history per thread, drawn into ratatui's TestBackend (the
+//! minute of history per thread, drawn into ratatui's `TestBackend` (the
 //! widgets and the buffer diff; no terminal writes). CPU time is the
 //! thread's own on-CPU time (Linux schedstat), so waiting for a core on a
 //! shared machine does not count.
@@ -54,7 +54,7 @@ fn on_cpu() -> Option<u64> {
 }
 
 fn main() -> anyhow::Result<()> {
-    let world = ballpit::scene::build_world(&Default::default())?;
+    let world = ballpit::scene::build_world(&ballpit::scene::SceneSpec::default())?;
     let settings = Settings {
         model: ModelKind::Swept,
         dt: 1.0 / 60.0,

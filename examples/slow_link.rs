@@ -1,10 +1,11 @@
 //! Key-to-screen latency of the real binary over an emulated slow link
 //! (issue 16). Run `cargo build --release` first, then
 //! `cargo run --release --example slow_link -- [KEYS] [BIN] [ONLY]`
-//! (ONLY: run just the links whose name contains it; NO_COLOR is passed on).
+//! (ONLY: run just the links whose name contains it; `NO_COLOR` is passed on).
 //! Prints, per link, the median and worst latency of KEYS presses of `v`
 //! at random moments, the frames per second shown by the app, and the
 //! bytes per second and per frame the screen received.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap fails the run
 #[path = "../tests/common/link.rs"]
 mod link;
 
@@ -53,7 +54,7 @@ fn main() {
             Duration::from_millis(600),
         );
         let (median, worst) = summary(&lat);
-        let each: Vec<u128> = lat.iter().map(|d| d.as_millis()).collect();
+        let each: Vec<u128> = lat.iter().map(std::time::Duration::as_millis).collect();
         eprintln!("{name}: each key, ms: {each:?}");
         // Throughput and frame rate over the next 3 s.
         let b0 = link.delivered.load(Ordering::Relaxed);

@@ -6,6 +6,7 @@
 //!
 //! `parts` (swept only): cut every step into that many parts instead of
 //! the number the scene calls for (0: that number).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap fails the run
 use ballpit::physics::sphere::volume;
 use ballpit::physics::swept::Swept;
 use ballpit::physics::{Exec, Model, ModelKind, Serial};
@@ -74,7 +75,7 @@ impl Exec for SequentialLanes {
     }
     #[inline(never)]
     fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
-        (0..self.0).for_each(f)
+        (0..self.0).for_each(f);
     }
     fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {
         a();

@@ -1,6 +1,4 @@
 //! ballpit: elastic spheres in a cube, on worker threads, drawn in a terminal.
-#![forbid(unsafe_code)]
-
 pub mod bench;
 pub mod cli;
 pub mod cpu;

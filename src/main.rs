@@ -1,4 +1,3 @@
-#![forbid(unsafe_code)]
 use ballpit::cli::{Cli, Command};
 use ballpit::error::BadInput;
 use ballpit::{bench, scene};
@@ -51,7 +50,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Some(Command::Tradeoff(args)) => {
             let world = scene::build_world(&args.scene.spec())?;
-            let table = ballpit::tradeoff::run(world, args.out.as_deref())?;
+            let table = ballpit::tradeoff::run(&world, args.out.as_deref())?;
             Ok(emit(table.as_bytes())?)
         }
         Some(Command::Completions { shell }) => {

@@ -307,7 +307,7 @@ pub fn svg(rows: &[Row], path: &Path) -> anyhow::Result<()> {
 
 /// Measure, and with `out` write `tradeoff.csv` and `tradeoff.svg` there;
 /// returns the table for the caller to print.
-pub fn run(world: World, out: Option<&Path>) -> anyhow::Result<String> {
+pub fn run(world: &World, out: Option<&Path>) -> anyhow::Result<String> {
     if let Some(dir) = out {
         // Before the minutes of measuring, not after: a bad path is bad input.
         std::fs::create_dir_all(dir).map_err(|e| {
@@ -315,7 +315,7 @@ pub fn run(world: World, out: Option<&Path>) -> anyhow::Result<String> {
         })?;
     }
     let bar = progress_bar();
-    let rows = measure_with(&world, &mut |done, next| {
+    let rows = measure_with(world, &mut |done, next| {
         bar.set_position(done as u64);
         bar.set_message(next.to_string());
     });
@@ -384,7 +384,7 @@ mod tests {
         let world = World::new(1.0, spheres);
         let mut seen = Vec::new();
         let rows = measure_with(&world, &mut |done, next| {
-            seen.push((done, next.to_string()))
+            seen.push((done, next.to_string()));
         });
         assert_eq!(rows.len(), ModelKind::COUNT * LADDER.len());
         assert_eq!(seen.len(), RUNS);

@@ -1,4 +1,5 @@
 //! Hand-computed cases for the contact maths and both step models.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use ballpit::physics::contact::{pair_toi, resolve_pair};
 use ballpit::physics::{ModelKind, Serial, Sphere, World};
 use glam::DVec3;

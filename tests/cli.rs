@@ -1,4 +1,5 @@
 //! The binary's command line: bench JSON, --dump, and bad input (exit 2).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use assert_cmd::Command;
 
 fn ballpit() -> Command {
@@ -101,6 +102,7 @@ fn dump_reads_back_as_the_same_scene() {
 }
 
 #[test]
+#[allow(clippy::too_many_lines)] // one table of bad inputs and what each must say
 fn bad_input_exits_2_with_one_clear_message() {
     let dir = std::env::temp_dir().join(format!("ballpit-bad-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -224,7 +226,7 @@ fn bad_input_exits_2_with_one_clear_message() {
     ] {
         let out = ballpit()
             .args(&args)
-            .timeout(std::time::Duration::from_secs(120))
+            .timeout(std::time::Duration::from_mins(2))
             .output()
             .unwrap();
         let err = String::from_utf8_lossy(&out.stderr);
@@ -410,7 +412,7 @@ fn bench_help_names_exactly_the_fields_the_json_has() {
         .keys()
         .map(|k| (line.find(&format!("\"{k}\":")).unwrap(), k.as_str()))
         .collect();
-    keys.sort();
+    keys.sort_unstable();
     let printed: Vec<&str> = keys.into_iter().map(|(_, k)| k).collect();
     let documented: Vec<&str> = ballpit::cli::BENCH_FIELDS.iter().map(|f| f.0).collect();
     assert_eq!(printed, documented, "bench --help and the JSON disagree");

@@ -1,6 +1,7 @@
 //! `swept` runs a step's contact events in clusters, side by side; the
 //! result must be the plain serial event loop's, bit for bit, on every kind
 //! of scene, however many lanes run the clusters.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use ballpit::physics::swept::Swept;
 use ballpit::physics::{Exec, Model, Serial, World};
 use ballpit::scene::{SceneSpec, build_world};
@@ -13,7 +14,7 @@ impl Exec for Lanes {
         self.0
     }
     fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
-        (0..self.0).rev().for_each(f)
+        (0..self.0).rev().for_each(f);
     }
     fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {
         b();

@@ -1,4 +1,5 @@
 //! The CPU sampler reads threads by name and agrees with the kernel.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use ballpit::cpu::{Sampler, current_tid, thread_cpu_seconds, thread_cpu_seconds_of};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};

@@ -1,5 +1,6 @@
 //! Any way of cutting the work gives the same bits: lanes run in any order,
 //! functional (split) or data (pool) decomposition.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use ballpit::physics::{Exec, ModelKind, Serial, World};
 use ballpit::scene::{SceneSpec, build_world};
 
@@ -15,7 +16,7 @@ impl Exec for Shuffled {
         self.lanes
     }
     fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
-        (0..self.lanes).rev().for_each(f)
+        (0..self.lanes).rev().for_each(f);
     }
     fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {
         b();

@@ -1,6 +1,7 @@
 //! The engine: every threading mode gives the same bits, mode switches lose
 //! nothing, the idle physics thread sleeps, panics come back as errors, and
 //! count and radius edits keep spheres apart and inside.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use ballpit::engine::{Command, Engine, Settings, Threading};
 use ballpit::physics::{Exec, Model, ModelKind, Sphere, World};
 use glam::DVec3;
@@ -300,9 +301,7 @@ impl Model for Faulty {
             match self.lane {
                 None => panic!("injected fault"),
                 Some(l) => exec.for_each_lane(&|lane| {
-                    if lane == l {
-                        panic!("injected fault on lane {lane}")
-                    }
+                    assert!(lane != l, "injected fault on lane {lane}");
                 }),
             }
         }

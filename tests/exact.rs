@@ -1,4 +1,5 @@
 //! The exact model against closed forms and its invariants.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use ballpit::physics::exact::Exact;
 use ballpit::physics::exact::lattice::lattice_world;
 use ballpit::physics::{Model, Serial, Sphere, World};
@@ -239,7 +240,7 @@ fn observer_and_results_use_world_indices() {
     m.set_observer(Some(Box::new(move |c| {
         s2.lock()
             .unwrap()
-            .push((c.i.min(c.j), c.i.max(c.j), c.pos_i.z.max(c.pos_j.z)))
+            .push((c.i.min(c.j), c.i.max(c.j), c.pos_i.z.max(c.pos_j.z)));
     })));
     m.advance(&mut w, 0.25, 1, &Serial);
     let seen = seen.lock().unwrap();

@@ -7,6 +7,8 @@
 //! second test holds today's coarser default grid to the same contacts until
 //! rounding makes the paths diverge (a crossing moves a sphere's lazy
 //! position, so the grid changes the last bits of the positions).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+#![allow(clippy::unreadable_literal)] // pinned hashes, as the failure prints them
 use ballpit::physics::exact::Exact;
 use ballpit::physics::exact::lattice::lattice_world;
 use ballpit::physics::{Model, Serial, Sphere, World};

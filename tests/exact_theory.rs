@@ -14,6 +14,7 @@
 //! walls does not bias them. Tolerances (3 %, 5 % for the walls) sit well
 //! above the statistical and finite-size errors here (under 1 %) and well
 //! below what missing 5 % of the collisions does to both figures.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use ballpit::physics::exact::lattice::lattice_world;
 use ballpit::physics::exact::{Contact, Exact};
 use ballpit::physics::{Counters, Model, Serial};

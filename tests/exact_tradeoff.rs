@@ -1,4 +1,5 @@
 //! `ballpit tradeoff` end to end on a small scene.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use assert_cmd::Command;
 use ballpit::physics::ModelKind;
 use ballpit::scene::{SceneSpec, build_world};

@@ -15,6 +15,7 @@
 //! - `discrete`: no escapes (wall contacts mirror back inside); overlap is not
 //!   bounded by the model (it grows with `dt · speed`, and fast spheres
 //!   tunnel), so only its finiteness is checked.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use assert_cmd::Command;
 use ballpit::physics::exact::Exact;
 use ballpit::physics::exact::lattice::lattice_world;

@@ -3,6 +3,8 @@
 //! many orders of magnitude, spheres placed exactly touching each other and
 //! the walls, equal velocities, zero velocities. More cases:
 //! `PROPTEST_CASES=20000 cargo test --release --test fuzz_exact`.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+#![allow(clippy::format_push_string)] // fuzz inputs read best as format strings
 use ballpit::physics::exact::Exact;
 use ballpit::physics::{Model, ModelKind, Serial, Sphere, World};
 use ballpit::scene::{SceneSpec, build_world, csv_io};

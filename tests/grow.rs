@@ -1,6 +1,7 @@
 //! The `R` key: spheres grow by the step, pushed apart where they would
 //! touch, until the box is truly full; energy, containment and the no-overlap
 //! promise hold at every press.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use ballpit::engine::{Command, Engine, Settings, Threading};
 use ballpit::physics::relax::{MAX_PACKING, packing};
 use ballpit::physics::{ModelKind, World};

@@ -1,6 +1,7 @@
 //! Hostile scene input: every kind gets one clear message naming what the
 //! user gave (a flag, a file's key, a file's line), exit code 2, and no
 //! panic, allocation blow-up or quadratic placement.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use assert_cmd::Command;
 use ballpit::scene::{SceneSpec, build_world, csv_io, toml_file};
 use std::time::{Duration, Instant};
@@ -303,6 +304,7 @@ mod fuzz {
 
         /// Any bytes as a CSV or TOML scene: a world or a message, no panic.
         #[test]
+        #[allow(clippy::format_collect)] // a test's input text
         fn scene_files_parse_or_say_why(
             rows in proptest::collection::vec(
                 proptest::collection::vec(one_of(&[

@@ -1,4 +1,5 @@
 //! Random valid scenes under every model: invariants hold.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use ballpit::physics::{ModelKind, Serial, World};
 use ballpit::scene::{SceneSpec, build_world};
 use proptest::prelude::*;

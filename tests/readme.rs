@@ -2,6 +2,7 @@
 //! relative link and every repository path it names exists, every command
 //! in its `sh` blocks parses with the real CLI and its flags and scene
 //! validate, and its TOML example is a scene ballpit reads.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use ballpit::cli::{Cli, Command, SceneArgs};
 use ballpit::scene::{self, presets};
 use std::path::{Path, PathBuf};
@@ -161,7 +162,7 @@ fn ballpit_args(line: &str) -> Option<Vec<String>> {
         ["cargo", "run", "--release"] => Some(vec!["ballpit".into()]),
         ["cargo", "run", "--release", "--", rest @ ..] => Some(
             std::iter::once("ballpit".to_string())
-                .chain(rest.iter().map(|s| s.to_string()))
+                .chain(rest.iter().map(std::string::ToString::to_string))
                 .collect(),
         ),
         ["cargo", "test", "--release"] => None,
@@ -171,6 +172,7 @@ fn ballpit_args(line: &str) -> Option<Vec<String>> {
 
 /// Build the scene the flags describe, unless it is a file an earlier
 /// command dumps (then that dump must come first).
+#[allow(clippy::case_sensitive_file_extension_comparisons)] // as the app reads them
 fn check_scene(scene_args: &SceneArgs, dumped: &[PathBuf], line: &str) {
     match scene_args.scene.as_deref() {
         Some(f) if f.ends_with(".csv") || f.ends_with(".toml") => {
@@ -217,7 +219,7 @@ fn every_command_the_readme_shows_parses_and_validates() {
                     dumped.extend(b.dump.iter().cloned());
                 }
                 Some(Command::Tradeoff(t)) => check_scene(&t.scene, &dumped, line),
-                Some(Command::Completions { .. }) | Some(Command::Man) => {}
+                Some(Command::Completions { .. } | Command::Man) => {}
             }
             parsed += 1;
         }

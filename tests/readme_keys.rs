@@ -3,6 +3,7 @@
 //! overlay and the key bar). A row's first cell holds its keys in
 //! backticks ("`p`/`P`", "`q`, `Esc`, `Ctrl-C`", "`←`/`→`/`↑`/`↓`"); a
 //! cell without backticks may say "arrows" for the four arrow keys.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use ballpit::tui::keys::TABLE;
 use std::collections::BTreeSet;
 

@@ -1,4 +1,5 @@
 //! Presets, placement, CSV round trip, TOML files.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use ballpit::physics::sphere::volume;
 use ballpit::scene::csv_io;
 use ballpit::scene::presets::PRESETS;

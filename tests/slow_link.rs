@@ -1,7 +1,8 @@
 //! Issue 16: the real binary over an emulated slow link (tests/common/link.rs):
 //! keys reach the screen in a fraction of a second, `q` quits at once, and a
 //! terminal that never answers queries is driven as fast as before. The
-//! latency table over several links is examples/slow_link.rs.
+//! latency table over several links is `examples/slow_link.rs`.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 mod common;
 
 use common::link::{Link, Spec, readout, style_key_latencies, summary};

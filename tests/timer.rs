@@ -4,6 +4,7 @@
 //! reported physics seconds must be at least (nearly) the CPU the thread
 //! burned over the same frames. Work done outside the timer (such as a
 //! detection made for a readout and reused by the next step) breaks that.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use ballpit::engine::{Engine, Settings, Threading};
 use ballpit::physics::{ModelKind, World};
 use ballpit::scene::{SceneSpec, build_world};

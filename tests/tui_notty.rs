@@ -1,4 +1,5 @@
 //! Started without a terminal, the app says so and exits 2.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use assert_cmd::Command;
 
 #[test]

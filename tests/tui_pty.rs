@@ -1,4 +1,5 @@
 //! The real binary in a real pseudo-terminal, its screen parsed with vt100.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 // Each test file uses part of the shared helpers.
 #[allow(dead_code)]
 #[path = "common/pty.rs"]
@@ -200,7 +201,7 @@ fn a_panic_in_another_thread_restores_the_terminal_then_prints_and_fails() {
     let raw = Arc::new(Mutex::new(Vec::new()));
     let r = raw.clone();
     let drain = thread::spawn(move || {
-        let mut buf = [0u8; 65536];
+        let mut buf = vec![0u8; 65536];
         while let Ok(n) = reader.read(&mut buf) {
             if n == 0 {
                 break;

@@ -1,4 +1,5 @@
-//! The screen parts at a fixed state, drawn on ratatui's TestBackend.
+//! The screen parts at a fixed state, drawn on ratatui's `TestBackend`.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use ballpit::cpu::{CpuReport, ThreadLoad};
 use ballpit::engine::{Engine, Settings, Snapshot, Threading};
 use ballpit::physics::{ModelKind, Sphere, World};
@@ -132,7 +133,7 @@ fn readouts(st: &AppState, snap: &Snapshot, palette: Palette) -> Terminal<TestBa
                 palette,
             },
             f.area(),
-        )
+        );
     })
 }
 
@@ -205,7 +206,7 @@ fn threads_panel() {
                 palette: Palette::C16,
             },
             f.area(),
-        )
+        );
     });
     insta::assert_snapshot!(t.backend());
 }
@@ -218,7 +219,7 @@ fn help_bar_and_overlay() {
                 palette: Palette::C16,
             },
             f.area(),
-        )
+        );
     });
     insta::assert_snapshot!("help_bar", t.backend());
     let t = render(70, 20, |f| {
@@ -227,7 +228,7 @@ fn help_bar_and_overlay() {
                 palette: Palette::C16,
             },
             f.area(),
-        )
+        );
     });
     insta::assert_snapshot!("help_overlay", t.backend());
 }
@@ -244,7 +245,7 @@ fn canvas(style: DrawStyle, palette: Palette) -> Terminal<TestBackend> {
     };
     let mut raster = Raster::new();
     render(40, 16, |f| {
-        raster.draw(&snap.spheres, &scene, f.area(), f.buffer_mut())
+        raster.draw(&snap.spheres, &scene, f.area(), f.buffer_mut());
     })
 }
 
@@ -280,7 +281,7 @@ fn small_canvas_shaded_without_colour_uses_a_glyph_ramp() {
         .buffer()
         .content()
         .iter()
-        .map(|c| c.symbol())
+        .map(ratatui::buffer::Cell::symbol)
         .collect();
     assert!(text.contains('@') && text.contains('+'), "{text}");
 }

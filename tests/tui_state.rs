@@ -1,4 +1,5 @@
 //! Every key's effect on the app state, without a terminal.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use ballpit::engine::{Command, Settings, Threading};
 use ballpit::physics::ModelKind;
 use ballpit::tui::canvas::{DrawStyle, LIGHT_STEPS};

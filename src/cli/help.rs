@@ -3,6 +3,7 @@
 use crate::engine::MAX_THREADS;
 use crate::scene::presets::PRESETS;
 use crate::tradeoff::CSV_COLUMNS;
+use std::fmt::Write as _;
 
 /// The fields of `bench`'s JSON line, in the order it prints them, with what
 /// each holds; `bench --help` shows them and a test holds them to the output.
@@ -79,7 +80,7 @@ pub(super) fn bench_after_help() -> String {
     let mut s = String::from("Prints one JSON line with these fields:\n");
     let w = BENCH_FIELDS.iter().map(|f| f.0.len()).max().unwrap_or(0);
     for (name, what) in BENCH_FIELDS {
-        s.push_str(&format!("  {name:<w$}  {what}\n"));
+        let _ = writeln!(s, "  {name:<w$}  {what}");
     }
     s.push_str("\nExample: ballpit bench --scene dense --model exact --threading pool --steps 600");
     s
@@ -101,7 +102,7 @@ pub(super) fn scene_long_help() -> String {
     );
     let w = PRESETS.iter().map(|p| p.name.len()).max().unwrap_or(0);
     for p in &PRESETS {
-        s.push_str(&format!("\n  {:<w$}  {}", p.name, p.about));
+        let _ = write!(s, "\n  {:<w$}  {}", p.name, p.about);
     }
     s
 }

@@ -42,6 +42,7 @@ pub struct Cli {
     #[arg(long, default_value_t = 30.0, value_name = "F", value_parser = parse_fps)]
     pub fps: f64,
     /// Colours (NO_COLOR is honoured unless this is given)
+    #[allow(clippy::doc_markdown)] // clap prints this as the help
     #[arg(long, value_enum, default_value_t = ColorArg::Auto, value_name = "COLORS")]
     pub color: ColorArg,
 }

@@ -1,5 +1,5 @@
 //! The terminal app as the command line opens it: shared by `main` and the
-//! examples that must start it the same way (examples/panic_probe.rs).
+//! examples that must start it the same way (`examples/panic_probe.rs`).
 use super::Cli;
 use crate::error::BadInput;
 use crate::tui::AfterFirstFrame;

@@ -55,6 +55,7 @@ impl From<ThreadingArg> for Threading {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum ColorArg {
     /// 16 colours if the terminal has colour, none under NO_COLOR
+    #[allow(clippy::doc_markdown)] // clap prints this as the help
     Auto,
     /// 16 colours: the fewest bytes over SSH
     #[value(name = "16")]
@@ -111,7 +112,7 @@ mod tests {
     fn names<T: ValueEnum>() -> Vec<String> {
         T::value_variants()
             .iter()
-            .filter_map(|v| v.to_possible_value())
+            .filter_map(ValueEnum::to_possible_value)
             .map(|p| p.get_name().to_string())
             .collect()
     }

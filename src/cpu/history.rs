@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 /// One sample per this much time...
 pub const STEP: Duration = Duration::from_secs(1);
 /// ...over this long: the sparkline's and the chart's "last minute".
-pub const SPAN: Duration = Duration::from_secs(60);
+pub const SPAN: Duration = Duration::from_mins(1);
 /// Samples in a full history.
 pub const LEN: usize = (SPAN.as_secs() / STEP.as_secs()) as usize;
 

@@ -68,7 +68,7 @@ impl Default for Sampler {
 
 impl Sampler {
     pub fn new() -> Sampler {
-        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
         Sampler {
             report: CpuReport {
                 cores,
@@ -107,9 +107,9 @@ impl Sampler {
         let mut threads: Vec<ThreadLoad> = self
             .tracks
             .iter_mut()
-            .map(|(&tid, t)| {
-                let &(t1, c1) = t.samples.back().expect("sampled just now");
-                let &(t0, c0) = t.samples.front().expect("sampled just now");
+            .filter_map(|(&tid, t)| {
+                // Every track kept was sampled just now.
+                let (&(t1, c1), &(t0, c0)) = (t.samples.back()?, t.samples.front()?);
                 let wall = t1.duration_since(t0).as_secs_f64();
                 let percent = if wall > 0.0 {
                     ((c1 - c0) / wall * 100.0).max(0.0)
@@ -117,13 +117,13 @@ impl Sampler {
                     0.0
                 };
                 t.history.push(now, percent);
-                ThreadLoad {
+                Some(ThreadLoad {
                     tid,
                     name: t.name.clone(),
                     percent,
                     cpu_seconds: c1,
                     history: t.history.values(),
-                }
+                })
             })
             .collect();
         threads.sort_by_key(|t| t.tid);

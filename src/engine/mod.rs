@@ -57,6 +57,7 @@ impl Threading {
     }
 
     /// The `d` key: worker → pool → split → worker (off stays off).
+    #[must_use]
     pub fn next_threaded(self) -> Threading {
         match self {
             Threading::Off => Threading::Off,
@@ -124,6 +125,7 @@ pub fn physics_threads(threading: Threading, threads: usize, model: ModelKind) -
     }
 }
 /// Seeds the placement of spheres added by `SetCount`, so runs repeat.
+#[allow(clippy::unreadable_literal)] // "ballpit!" in ASCII
 const EDIT_SEED: u64 = 0x62616c6c70697421;
 
 /// Owns the world and runs frames in the chosen threading mode.
@@ -194,6 +196,8 @@ impl Engine {
 
     /// Begin computing the next frame: threaded modes return at once, `off`
     /// computes it here. A frame still running is finished first.
+    // The frame is home once check() passed and none is in flight.
+    #[allow(clippy::expect_used, clippy::missing_panics_doc)]
     pub fn start_frame(&mut self) -> anyhow::Result<()> {
         if self.in_flight {
             self.finish_frame()?;
@@ -240,6 +244,7 @@ impl Engine {
     /// # Panics
     /// While a frame is in flight or after the physics failed; see
     /// [`Engine::try_world`].
+    #[allow(clippy::expect_used)] // the documented panic; try_world is the checked form
     pub fn world(&self) -> &World {
         self.try_world()
             .expect("Engine::world needs a finished frame: call finish_frame first")
@@ -356,6 +361,7 @@ impl Engine {
     }
 
     /// The spheres changed from outside the model.
+    #[allow(clippy::unused_self)] // one of the engine's steps, called as one
     fn edited(&self, frame: &mut Frame) {
         frame.world.touch();
         frame.model.invalidate();
@@ -364,6 +370,7 @@ impl Engine {
 
     /// The executor for the current mode; pools are made when first needed
     /// and kept (asleep) while other modes run.
+    #[allow(clippy::single_match_else)] // the same shape as the pool arm
     fn exec(&mut self) -> anyhow::Result<SharedExec> {
         Ok(match self.settings.threading {
             Threading::Off | Threading::Worker => self.serial.clone(),

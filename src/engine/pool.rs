@@ -95,7 +95,7 @@ impl Exec for SplitExec {
     }
 
     fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
-        f(0)
+        f(0);
     }
 
     fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {

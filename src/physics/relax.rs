@@ -126,7 +126,7 @@ mod tests {
         // Each moves less than the whole overlap (0.25 from 0.05 apart).
         assert!(d < 0.05 + 2.0 * 0.25, "moved too far: {d}");
         assert_eq!((out[0].vel, out[0].mass), (a.vel, a.mass));
-        assert_eq!(out[0].radius, 0.15000000000000002);
+        assert_eq!(out[0].radius, 0.150_000_000_000_000_02);
     }
 
     #[test]

@@ -49,6 +49,7 @@ fn label(flag: &str, given_as_flag: bool, file_with_key: Option<&str>) -> String
 }
 
 /// The text of a scene file, or a message saying where it is not UTF-8.
+#[allow(clippy::naive_bytecount)] // once per bad file: no crate for it
 pub(crate) fn read_text(path: &Path) -> Result<String, BadInput> {
     let bytes = std::fs::read(path)
         .map_err(|e| bad_input!("cannot read scene file {}: {e}", path.display()))?;
@@ -60,6 +61,7 @@ pub(crate) fn read_text(path: &Path) -> Result<String, BadInput> {
 }
 
 /// The 1-based line holding byte `at` of `text`.
+#[allow(clippy::naive_bytecount)] // once per message: no crate for it
 pub(crate) fn line_of(text: &str, at: usize) -> usize {
     text.as_bytes()[..at.min(text.len())]
         .iter()
@@ -75,6 +77,12 @@ pub fn build_world(spec: &SceneSpec) -> Result<World, BadInput> {
 
 /// [`build_world`] for a run that starts with `model`: `discrete` takes a
 /// scene file with overlapping spheres (as its own `--dump` may hold).
+// The extensions are the documented lower-case ones; the checks read in the
+// order the messages promise.
+#[allow(
+    clippy::case_sensitive_file_extension_comparisons,
+    clippy::too_many_lines
+)]
 pub fn build_world_for(spec: &SceneSpec, model: Option<ModelKind>) -> Result<World, BadInput> {
     let overlaps = if model == Some(ModelKind::Discrete) {
         place::Overlaps::Allow

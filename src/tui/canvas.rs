@@ -25,6 +25,7 @@ pub enum DrawStyle {
 
 impl DrawStyle {
     /// The `v` key's cycle, in the order of declaration.
+    #[must_use]
     pub fn next(self) -> DrawStyle {
         DrawStyle::iter()
             .cycle()
@@ -61,7 +62,7 @@ pub struct Scene {
     pub box_size: f64,
     pub camera: Camera,
     pub style: DrawStyle,
-    /// 0..LIGHT_STEPS.
+    /// `0..LIGHT_STEPS`.
     pub light: u8,
     pub palette: Palette,
     /// Cell height / width.
@@ -460,6 +461,7 @@ mod tests {
     }
 
     #[test]
+    #[allow(clippy::naive_bytecount)] // a test: no crate for it
     fn tiny_spheres_are_single_points() {
         let mut r = Raster::new();
         let sc = scene(DrawStyle::PointsSpeed);

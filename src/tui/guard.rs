@@ -240,7 +240,7 @@ mod tests {
         w.write_all(b"frame 2").unwrap();
         let restore = sink.clone();
         std::thread::spawn(move || {
-            latch.close(|| restore.0.lock().extend_from_slice(b"|restored"))
+            latch.close(|| restore.0.lock().extend_from_slice(b"|restored"));
         })
         .join()
         .unwrap();
@@ -254,10 +254,6 @@ mod tests {
 
     #[test]
     fn restore_waits_for_a_write_in_progress() {
-        let latch: &'static Latch = Box::leak(Box::new(Latch::new()));
-        latch.open();
-        let (started_tx, started) = crossbeam_channel::bounded(0);
-        let (go_tx, go) = crossbeam_channel::bounded::<()>(0);
         struct Slow(
             Sink,
             crossbeam_channel::Sender<()>,
@@ -273,6 +269,10 @@ mod tests {
                 Ok(())
             }
         }
+        let latch: &'static Latch = Box::leak(Box::new(Latch::new()));
+        latch.open();
+        let (started_tx, started) = crossbeam_channel::bounded(0);
+        let (go_tx, go) = crossbeam_channel::bounded::<()>(0);
         let sink = Sink::default();
         let mut w = Gated::new(Slow(sink.clone(), started_tx, go), latch);
         let writer = std::thread::spawn(move || w.write_all(b"frame"));

@@ -1,5 +1,5 @@
 //! The one key table: dispatch (`input::action`), the `?` overlay, the key
-//! bar and the README check (tests/readme_keys.rs) all read `TABLE`, so a
+//! bar and the README check (`tests/readme_keys.rs`) all read `TABLE`, so a
 //! key cannot be added in one place and forgotten in another.
 use super::input::Action;
 

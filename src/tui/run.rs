@@ -26,7 +26,7 @@ use std::time::{Duration, Instant};
 const SAMPLE_PERIOD: Duration = Duration::from_secs(1);
 
 /// Called once on the frame loop's thread when the first frame has gone to
-/// the terminal (examples/panic_probe.rs uses it; the app passes none).
+/// the terminal (`examples/panic_probe.rs` uses it; the app passes none).
 pub type AfterFirstFrame = Box<dyn FnOnce()>;
 
 /// Open the screen on `world` and run until the user quits.
@@ -76,7 +76,7 @@ pub fn run_with(
     reader::spawn_input(tx.clone())?;
     let mut result = FrameLoop::new(engine, state, palette, detected, tx).and_then(|mut l| {
         l.after_first_frame = after_first_frame;
-        l.run(rx)
+        l.run(&rx)
     });
     // A panic restores the terminal, so the frame loop may stop on a refused
     // write first: the panic is the reason to report.
@@ -188,7 +188,7 @@ impl FrameLoop {
         })
     }
 
-    fn run(mut self, rx: Receiver<Msg>) -> anyhow::Result<()> {
+    fn run(mut self, rx: &Receiver<Msg>) -> anyhow::Result<()> {
         let mut next_frame = Instant::now();
         let mut next_sample = Instant::now() + SAMPLE_PERIOD;
         loop {

@@ -15,6 +15,7 @@ pub const MAX_PITCH: f64 = 1.5;
 pub const FPS_STEPS: [f64; 7] = [5.0, 10.0, 15.0, 20.0, 30.0, 60.0, 120.0];
 
 #[derive(Clone, Debug, PartialEq)]
+#[allow(clippy::struct_excessive_bools)] // independent toggles, one a key
 pub struct AppState {
     pub threading: Threading,
     /// Where `t` goes back to; `d` cycles it while threading is off.
@@ -69,6 +70,7 @@ impl AppState {
     }
 
     /// Do one key; returns what the engine must be told.
+    #[allow(clippy::too_many_lines)] // one arm a key, as the key table lists them
     pub fn apply(&mut self, action: Action) -> Vec<Command> {
         self.notice = None;
         let mut out = Vec::new();
@@ -200,7 +202,7 @@ impl AppState {
             Action::FasterFps => match FPS_STEPS.iter().find(|&&f| f > self.fps + 1e-9) {
                 Some(&f) => self.fps = f,
                 None => {
-                    self.notice = Some(format!("fps limit: {}", FPS_STEPS[FPS_STEPS.len() - 1]))
+                    self.notice = Some(format!("fps limit: {}", FPS_STEPS[FPS_STEPS.len() - 1]));
                 }
             },
         }

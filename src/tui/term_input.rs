@@ -66,21 +66,17 @@ impl Parser {
         let mut at = 0;
         while at < self.pending.len() {
             if let Some(len) = self.paste {
-                match self.paste_step(at, len) {
-                    Some(next) => {
-                        at = next;
-                        out.push(Input::Paste(self.paste.take().unwrap_or(0)));
-                    }
-                    None => {
-                        // Keep only what could be the start of the end marker.
-                        let keep = marker_prefix(&self.pending[at..]);
-                        let consumed = self.pending.len() - at - keep;
-                        self.paste = Some(len + consumed);
-                        at = self.pending.len() - keep;
-                        break;
-                    }
+                if let Some(next) = self.paste_step(at, len) {
+                    at = next;
+                    out.push(Input::Paste(self.paste.take().unwrap_or(0)));
+                    continue;
                 }
-                continue;
+                // Keep only what could be the start of the end marker.
+                let keep = marker_prefix(&self.pending[at..]);
+                let consumed = self.pending.len() - at - keep;
+                self.paste = Some(len + consumed);
+                at = self.pending.len() - keep;
+                break;
             }
             match parse_one(&self.pending[at..]) {
                 Step::Event(n, ev) => {

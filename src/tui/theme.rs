@@ -39,7 +39,7 @@ impl Palette {
     }
 
     /// Resolve `--color` against the environment. An explicit flag wins over
-    /// `NO_COLOR` (the NO_COLOR convention lets flags override it).
+    /// `NO_COLOR` (the `NO_COLOR` convention lets flags override it).
     pub fn resolve(choice: ColorChoice, env: &dyn Fn(&str) -> Option<String>) -> Palette {
         match choice {
             ColorChoice::C16 => Palette::C16,

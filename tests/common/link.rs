@@ -3,8 +3,9 @@
 //! one-way delay each way, feeds it to a vt100 screen, and answers the
 //! device status query (`ESC[5n` → `ESC[0n`), cursor position (`ESC[6n`)
 //! and device attributes (`ESC[c`) only once it has consumed the bytes before
-//! them, as a real terminal does. Shared by tests/slow_link.rs and
-//! examples/slow_link.rs.
+//! them, as a real terminal does. Shared by `tests/slow_link.rs` and
+//! `examples/slow_link.rs`.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 #![allow(dead_code)]
 use crossbeam_channel::{Receiver, Sender, unbounded};
 use portable_pty::{CommandBuilder, MasterPty, PtySize, native_pty_system};
@@ -61,6 +62,7 @@ fn sleep_until(t: Instant) {
 const QUERIES: [&[u8]; 3] = [b"\x1b[5n", b"\x1b[6n", b"\x1b[c"];
 
 impl Link {
+    #[allow(clippy::too_many_lines)] // the link's three threads, set up in one place
     pub fn start(mut cmd: CommandBuilder, spec: Spec) -> Link {
         let pty = native_pty_system()
             .openpty(PtySize {

@@ -1,6 +1,7 @@
 //! The real binary in a real pseudo-terminal, its screen parsed with vt100:
 //! start it, type, resize, and wait (with a deadline) for what the screen
 //! shows. Shared by the pty tests.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use portable_pty::{CommandBuilder, MasterPty, PtySize, native_pty_system};
 use std::io::{Read, Write};
 use std::sync::{Arc, Mutex};
@@ -51,7 +52,7 @@ pub fn start_with(
     let screen = Arc::new(Mutex::new(vt100::Parser::new(nz(rows), nz(cols), 0)));
     let s = screen.clone();
     let reader = thread::spawn(move || {
-        let mut buf = [0u8; 65536];
+        let mut buf = vec![0u8; 65536];
         loop {
             match reader.read(&mut buf) {
                 Ok(0) | Err(_) => return,
@@ -142,9 +143,10 @@ impl App {
             if pred(&t) {
                 return t;
             }
-            if Instant::now() > end {
-                panic!("timed out waiting for {what}; screen:\n{t}");
-            }
+            assert!(
+                Instant::now() <= end,
+                "timed out waiting for {what}; screen:\n{t}"
+            );
             thread::sleep(Duration::from_millis(50));
         }
     }
