@@ -12,16 +12,17 @@ use ballpit::engine::{Engine, Settings, Snapshot, Threading};
 use ballpit::physics::{ModelKind, Sphere, World};
 use ballpit::tui::app::{self, View};
 use ballpit::tui::canvas::{DrawStyle, Raster};
-use ballpit::tui::output::{BEGIN_SYNC, Counting, END_SYNC, Lean};
+use ballpit::tui::output::{Counting, Lean};
 use ballpit::tui::readouts::Stats;
 use ballpit::tui::state::AppState;
 use ballpit::tui::theme::Palette;
 use criterion::{Criterion, criterion_group};
+use crossterm::queue;
+use crossterm::terminal::{BeginSynchronizedUpdate, EndSynchronizedUpdate};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use ratatui::layout::Rect;
 use ratatui::{Terminal, TerminalOptions, Viewport};
-use std::io::Write;
 use std::sync::atomic::Ordering;
 
 fn lattice_world(n: usize, radius: f64, speed: f64, seed: u64) -> World {
@@ -79,9 +80,9 @@ fn terminal(w: u16, h: u16) -> (Term, std::sync::Arc<std::sync::atomic::AtomicU6
 }
 
 fn frame(t: &mut Term, raster: &mut Raster, view: &View) {
-    t.backend_mut().write_all(BEGIN_SYNC).unwrap();
+    queue!(t.backend_mut(), BeginSynchronizedUpdate).unwrap();
     t.draw(|f| app::draw(f, raster, view)).unwrap();
-    t.backend_mut().write_all(END_SYNC).unwrap();
+    queue!(t.backend_mut(), EndSynchronizedUpdate).unwrap();
 }
 
 /// Snapshots of `frames` consecutive frames.

@@ -1,10 +1,9 @@
 //! Getting out cleanly: the terminal is put back on every way out (normal
 //! return, error, panic in any thread, SIGTERM/SIGHUP/SIGINT), and a terminal
 //! that goes away ends the process instead of leaving it spinning.
-use super::output::END_SYNC;
 use crossbeam_channel::Sender;
 use crossterm::event::KeyEvent;
-use crossterm::{cursor, execute, terminal};
+use crossterm::{cursor, execute, queue, terminal};
 use parking_lot::Mutex;
 use std::io::{self, Write};
 use std::sync::OnceLock;
@@ -164,7 +163,7 @@ pub fn panicked() -> bool {
 pub fn restore() {
     TERMINAL.close(|| {
         let mut out = io::stdout();
-        let _ = out.write_all(END_SYNC);
+        let _ = queue!(out, terminal::EndSynchronizedUpdate);
         let _ = out.write_all(b"\x1b[0m");
         let _ = out.write_all(PASTE_OFF);
         let _ = execute!(out, cursor::Show, terminal::LeaveAlternateScreen);

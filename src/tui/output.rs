@@ -9,9 +9,6 @@ use std::io::{self, Write};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-pub const BEGIN_SYNC: &[u8] = b"\x1b[?2026h";
-pub const END_SYNC: &[u8] = b"\x1b[?2026l";
-
 /// Counts every byte passed to the inner writer.
 pub struct Counting<W: Write> {
     inner: W,
@@ -263,7 +260,7 @@ mod tests {
     fn counts_what_passes_through() {
         let (mut w, count) = Counting::new(Vec::new());
         w.write_all(b"hello").unwrap();
-        w.write_all(BEGIN_SYNC).unwrap();
+        w.write_all(b"\x1b[?2026h").unwrap();
         assert_eq!(count.load(Ordering::Relaxed), 5 + 8);
         assert_eq!(w.inner.len(), 13);
     }

@@ -2,7 +2,7 @@
 use super::app::{self, View};
 use super::canvas::Raster;
 use super::guard::{self, Guard, Msg};
-use super::output::{BEGIN_SYNC, Counting, END_SYNC, Lean, Sink};
+use super::output::{Counting, Lean, Sink};
 use super::pacing::{self, Pacer};
 use super::readouts::Stats;
 use super::state::AppState;
@@ -15,9 +15,11 @@ use crate::error::BadInput;
 use crate::physics::World;
 use anyhow::{Context, anyhow};
 use crossbeam_channel::{Receiver, RecvTimeoutError, Sender};
+use crossterm::queue;
+use crossterm::terminal::{BeginSynchronizedUpdate, EndSynchronizedUpdate};
 use ratatui::Terminal;
 use ratatui::backend::Backend;
-use std::io::{self, IsTerminal, Write};
+use std::io::{self, IsTerminal};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -346,10 +348,10 @@ impl FrameLoop {
             aspect: self.aspect,
         };
         let raster = &mut self.raster;
-        self.terminal.backend_mut().write_all(BEGIN_SYNC)?;
+        queue!(self.terminal.backend_mut(), BeginSynchronizedUpdate)?;
         self.terminal.draw(|f| app::draw(f, raster, &view))?;
         let backend = self.terminal.backend_mut();
-        backend.write_all(END_SYNC)?;
+        queue!(backend, EndSynchronizedUpdate)?;
         Backend::flush(backend)?;
         let frame = self.sink.take();
         let asked = self.pacer.asks();
