@@ -5,8 +5,9 @@ mod help;
 mod screen;
 mod values;
 
+pub use crate::tui::MAX_FPS;
 pub use help::BENCH_FIELDS;
-pub use values::{ColorArg, MAX_FPS, ModelArg, ThreadingArg};
+pub use values::{ColorArg, ModelArg, ThreadingArg};
 
 use crate::bad;
 use crate::engine::{MAX_THREADS, Settings, default_threads};

@@ -2,7 +2,7 @@
 //! and the parsers of `--dt` and `--fps`.
 use crate::engine::Threading;
 use crate::physics::ModelKind;
-use crate::tui::ColorChoice;
+use crate::tui::{ColorChoice, MAX_FPS};
 use clap::ValueEnum;
 use std::time::Duration;
 
@@ -88,9 +88,6 @@ pub(super) fn parse_seconds(s: &str) -> Result<f64, String> {
     };
     v.map_err(|_| "expected seconds as a number or a fraction, e.g. 0.01 or 1/60".to_string())
 }
-
-/// Largest frame rate `--fps` accepts.
-pub const MAX_FPS: f64 = 1000.0;
 
 pub(super) fn parse_fps(s: &str) -> Result<f64, String> {
     let fps: f64 = s

@@ -27,6 +27,9 @@ pub mod writer;
 pub use run::{AfterFirstFrame, run, run_with};
 pub use theme::ColorChoice;
 
+/// Largest frame rate the frame loop takes (`--fps`).
+pub const MAX_FPS: f64 = 1000.0;
+
 /// What the command line sets for the screen.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Options {

@@ -8,7 +8,7 @@ use super::readouts::Stats;
 use super::state::AppState;
 use super::theme::Palette;
 use super::writer::Output;
-use super::{Options, input, reader};
+use super::{MAX_FPS, Options, input, reader};
 use crate::cpu::{CpuReport, Sampler};
 use crate::engine::{Command, Engine, Settings, Snapshot};
 use crate::error::BadInput;
@@ -43,9 +43,9 @@ pub fn run_with(
     opts: Options,
     after_first_frame: Option<AfterFirstFrame>,
 ) -> anyhow::Result<()> {
-    if !(opts.fps.is_finite() && opts.fps > 0.0 && opts.fps <= 1000.0) {
+    if !(opts.fps.is_finite() && opts.fps > 0.0 && opts.fps <= MAX_FPS) {
         return Err(BadInput(format!(
-            "--fps must be greater than 0 and at most 1000, got {}",
+            "--fps must be greater than 0 and at most {MAX_FPS}, got {}",
             opts.fps
         ))
         .into());
