@@ -1,7 +1,7 @@
 //! The exact model against closed forms and its invariants.
 use ballpit::physics::exact::Exact;
-use ballpit::physics::exact::lattice::lattice_world;
 use ballpit::physics::{Model, Serial, Sphere, World};
+use ballpit::scene::lattice::lattice_world;
 use glam::DVec3;
 
 fn sphere(pos: [f64; 3], vel: [f64; 3], r: f64) -> Sphere {

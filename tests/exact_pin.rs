@@ -8,8 +8,8 @@
 //! rounding makes the paths diverge (a crossing moves a sphere's lazy
 //! position, so the grid changes the last bits of the positions).
 use ballpit::physics::exact::Exact;
-use ballpit::physics::exact::lattice::lattice_world;
 use ballpit::physics::{Model, Serial, Sphere, World};
+use ballpit::scene::lattice::lattice_world;
 use ballpit::scene::{SceneSpec, build_world};
 use glam::DVec3;
 use std::sync::{Arc, Mutex};

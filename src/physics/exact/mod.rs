@@ -5,12 +5,12 @@
 //! - lazy update: each sphere carries its own time stamp ([`body`]) and is
 //!   moved only when an event touches it or when `advance` returns;
 //! - one pending event per sphere (the earliest of contact, wall, or its
-//!   broad-phase event), in a tournament tree ([`queue`]);
+//!   broad-phase event), in an [`EventQueue`] (a tournament tree);
 //! - a broad phase chosen by packing fraction ([`LISTS_ABOVE_PACKING`]):
-//!   cells with cell-crossing events for dilute and moderate scenes
-//!   ([`cells`]), neighbour lists with a skin for dense ones
-//!   ([`neighbours`]); both keep the few spheres far larger than the bulk on
-//!   a second level, so radii 100x apart stay cheap;
+//!   a cell grid with cell-crossing events for dilute and moderate scenes
+//!   ([`cell_grid`]), neighbour lists with a skin for dense ones
+//!   ([`neighbour_lists`]); both keep the few spheres far larger than the
+//!   bulk on a second level ([`large`]), so radii 100x apart stay cheap;
 //! - stale predictions detected by per-sphere collision counts ([`schedule`]).
 //!
 //! Time of impact comes from [`pair_toi`](crate::physics::contact::pair_toi)
@@ -37,11 +37,9 @@
 //! (contacts in its remainder are missed, so overlaps may then appear), and
 //! the schedule is rebuilt for the next step.
 pub mod body;
-pub mod cell_list;
-pub mod cell_slots;
-pub mod cells;
-pub mod lattice;
-pub mod neighbours;
+pub mod cell_grid;
+pub mod large;
+pub mod neighbour_lists;
 pub mod queue;
 pub mod schedule;
 
@@ -51,10 +49,11 @@ use super::flight::fly;
 use super::model::{Model, ModelKind};
 use super::world::{Counters, World};
 use body::Body;
-use cells::Cells;
+use cell_grid::CellGrid;
 use glam::DVec3;
-use neighbours::Neighbours;
-use queue::EventQueue;
+use neighbour_lists::NeighbourLists;
+pub use queue::EventQueue;
+use queue::Tournament;
 use schedule::{Event, Kind, Predictor};
 
 /// Events (contacts, wall hits, relists, stale predictions) a step may take,
@@ -64,6 +63,8 @@ pub const EVENT_CAP_PER_SPHERE: u64 = 100;
 /// Internal times are kept relative to an origin that moves with the frames,
 /// so lazy positions `x + v (t - t_i)` never subtract large times.
 const ORIGIN_SPAN: f64 = 1.0;
+/// "No sphere" / "no cell" in the broad phases' `u32` indices.
+pub const NONE: u32 = u32::MAX;
 
 /// Above this packing fraction the broad phase is neighbour lists (a
 /// sphere's free path is short, so it meets its skin's edge rarely and
@@ -76,8 +77,8 @@ pub const LISTS_ABOVE_PACKING: f64 = 0.3;
 /// each rebuild.
 #[derive(Clone, Debug)]
 enum Broad {
-    Lists(Box<Neighbours>),
-    Cells(Box<Cells>),
+    Lists(Box<NeighbourLists>),
+    Cells(Box<CellGrid>),
 }
 
 impl Default for Broad {
@@ -102,8 +103,14 @@ pub struct Contact {
 
 pub type Observer = Box<dyn FnMut(&Contact) + Send>;
 
+/// The model, with today's event queue.
+pub type Exact = EventDriven<Tournament>;
+
+/// The model over an event queue `Q` (one implementation today; a type
+/// parameter, so another can be tried without touching the loop, at no cost
+/// to this one).
 #[derive(Default)]
-pub struct Exact {
+pub struct EventDriven<Q: EventQueue> {
     bodies: Vec<Body>,
     mass: Vec<f64>,
     /// World index of each body: bodies are kept in a spatial order (sorted
@@ -115,7 +122,7 @@ pub struct Exact {
     /// Cell mode: each sphere's best contact or wall event (absolute time),
     /// kept apart from its crossing so a crossing rescans only new cells.
     pending: Vec<(f64, Event)>,
-    queue: EventQueue,
+    queue: Q,
     broad: Broad,
     /// Scratch for the candidates a prediction gathers.
     candidates: Vec<u32>,
@@ -145,7 +152,7 @@ pub struct EventStats {
     pub rebuilds: u64,
 }
 
-impl Exact {
+impl<Q: EventQueue> EventDriven<Q> {
     /// Set the events a step may take (default: [`EVENT_CAP_BASE`] plus
     /// [`EVENT_CAP_PER_SPHERE`] per sphere).
     pub fn with_event_cap(mut self, cap: u64) -> Self {
@@ -154,7 +161,7 @@ impl Exact {
     }
 
     /// Set the most cells per sphere of the cell grid (default
-    /// [`cells::CELLS_PER_SPHERE`]; at least 1), for comparing grids.
+    /// [`cell_grid::CELLS_PER_SPHERE`]; at least 1), for comparing grids.
     pub fn with_cells_per_sphere(mut self, k: u32) -> Self {
         self.cells_per_sphere = Some(k.max(1));
         self
@@ -257,15 +264,15 @@ impl Exact {
             .map(|b| crate::physics::sphere::volume(b.radius))
             .sum();
         if filled > LISTS_ABOVE_PACKING * self.size.powi(3) {
-            let mut nl = Box::<Neighbours>::default();
+            let mut nl = Box::<NeighbourLists>::default();
             nl.build(&self.bodies, self.size);
             self.broad = Broad::Lists(nl);
             // Only cells keep a pending event apart from the broad phase's.
             self.pending = Vec::new();
         } else {
             self.pending.resize(n, (f64::INFINITY, Event::default()));
-            let mut cells = Box::<Cells>::default();
-            let per_sphere = self.cells_per_sphere.unwrap_or(cells::CELLS_PER_SPHERE);
+            let mut cells = Box::<CellGrid>::default();
+            let per_sphere = self.cells_per_sphere.unwrap_or(cell_grid::CELLS_PER_SPHERE);
             cells.build(&self.bodies, self.size, per_sphere);
             self.broad = Broad::Cells(cells);
         }
@@ -508,7 +515,7 @@ impl Exact {
     }
 }
 
-impl Model for Exact {
+impl<Q: EventQueue + Send> Model for EventDriven<Q> {
     fn kind(&self) -> ModelKind {
         ModelKind::Exact
     }

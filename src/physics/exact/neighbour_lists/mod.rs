@@ -14,12 +14,14 @@
 //! few much larger spheres live on a second level — every small sphere checks
 //! them when it rebuilds, and a large one scans the grid cells over its own
 //! reach.
+pub mod chains;
+
+use super::NONE;
 use super::body::Body;
+use super::large::{BIG_FACTOR, split_big, time_to_leave};
+use chains::CellChains;
 use glam::DVec3;
 
-use super::cell_list::{CellList, NONE, split_big, time_to_leave};
-/// A sphere counts as large (second level) above this multiple of the bulk radius.
-const BIG_FACTOR: f64 = 3.0;
 /// Skin as a fraction of the bulk radius, at least: a quarter diameter
 /// (Smallenburg's 1.5 shell), best for dense scenes.
 const SKIN_MIN_RADII: f64 = 0.5;
@@ -171,19 +173,19 @@ impl Lists {
 }
 
 #[derive(Clone, Debug, Default)]
-pub struct Neighbours {
+pub struct NeighbourLists {
     skin: f64,
     centre: Vec<Centre>,
     lists: Lists,
     per_side: usize,
     inv_cell: f64,
     /// The spheres of each cell, by centre; second-level ones are in none.
-    cells: CellList,
+    cells: CellChains,
     bigs: Vec<u32>,
     small_rmax: f64,
 }
 
-impl Neighbours {
+impl NeighbourLists {
     /// Bytes held on the heap.
     pub fn heap_bytes(&self) -> usize {
         let l = &self.lists;
