@@ -11,14 +11,18 @@
 //!   ([`cell_grid`]), neighbour lists with a skin for dense ones
 //!   ([`neighbour_lists`]); both keep the few spheres far larger than the
 //!   bulk on a second level ([`large`]), so radii 100x apart stay cheap;
-//! - stale predictions detected by per-sphere collision counts ([`schedule`]).
+//! - stale predictions detected by per-sphere collision counts ([`schedule`]);
+//! - spheres relabelled in space as they drift ([`renumber`]), so neighbours
+//!   sit together in memory; the world keeps every sphere at its id.
 //!
 //! Time of impact comes from [`pair_toi`](crate::physics::contact::pair_toi)
 //! (stable quadratic, rounding guard: overlapping and approaching collides
 //! now, receding is left alone). Simultaneous events are processed in a
 //! fixed order: by the sphere whose prediction it is, in the model's
-//! internal order (spatially sorted when the schedule is built, a pure
-//! function of the world); a sphere's own candidates tie its broad-phase
+//! internal order (sorted in space at load and again as the spheres drift,
+//! [`renumber`]: a pure function of the world and its history; a contact
+//! taken by either of its spheres is the same contact, bit for bit, and is
+//! reported lower world id first); a sphere's own candidates tie its broad-phase
 //! event (relist or crossing) first, then walls, then partners in the order
 //! the broad phase offers them.
 //! Runs are therefore reproducible, and the event loop runs on one thread
@@ -41,6 +45,7 @@ pub mod cell_grid;
 pub mod large;
 pub mod neighbour_lists;
 pub mod queue;
+pub mod renumber;
 pub mod schedule;
 
 use super::contact::{reflect_walls, resolve_pair};
@@ -134,6 +139,10 @@ pub struct EventDriven<Q: EventQueue> {
     valid: bool,
     cap: Option<u64>,
     cells_per_sphere: Option<u32>,
+    /// Keep the load's spatial order only (for measuring what renumbering buys).
+    no_renumbering: bool,
+    /// Broad-phase events (crossings, relists) at the last spatial sort.
+    sorted_at: u64,
     observer: Option<Observer>,
     /// Events processed since construction, by kind.
     pub stats: EventStats,
@@ -150,6 +159,8 @@ pub struct EventStats {
     pub crossings: u64,
     /// Full rebuilds of the schedule (start, outside changes, capped steps).
     pub rebuilds: u64,
+    /// Spatial re-sorts of the spheres ([`renumber`]).
+    pub renumberings: u64,
 }
 
 impl<Q: EventQueue> EventDriven<Q> {
@@ -164,6 +175,13 @@ impl<Q: EventQueue> EventDriven<Q> {
     /// [`cell_grid::CELLS_PER_SPHERE`]; at least 1), for comparing grids.
     pub fn with_cells_per_sphere(mut self, k: u32) -> Self {
         self.cells_per_sphere = Some(k.max(1));
+        self
+    }
+
+    /// Keep the spheres in the order the load gave them (default: sorted
+    /// again by cell as they drift), for comparing the two.
+    pub fn with_renumbering(mut self, on: bool) -> Self {
+        self.no_renumbering = !on;
         self
     }
 
@@ -214,28 +232,7 @@ impl<Q: EventQueue> EventDriven<Q> {
         self.size = world.size;
         self.origin = world.time;
         self.synced_time = world.time;
-        let n = world.spheres.len();
-        let side = ((n as f64).cbrt().ceil() as usize).max(1);
-        let cell = |x: f64| ((x / world.size * side as f64) as usize).min(side - 1);
-        let key =
-            |p: DVec3| cell(p.x.max(0.0)) + side * (cell(p.y.max(0.0)) + side * cell(p.z.max(0.0)));
-        // A counting sort by cell: linear, and stable (ties in world order),
-        // so the order is the one a stable sort by key gives.
-        let keys: Vec<u32> = world.spheres.iter().map(|s| key(s.pos) as u32).collect();
-        let mut start = vec![0u32; side * side * side + 1];
-        for &k in &keys {
-            start[k as usize + 1] += 1;
-        }
-        for c in 1..start.len() {
-            start[c] += start[c - 1];
-        }
-        self.order.clear();
-        self.order.resize(n, 0);
-        for (i, &k) in keys.iter().enumerate() {
-            let at = &mut start[k as usize];
-            self.order[*at as usize] = i as u32;
-            *at += 1;
-        }
+        self.order = renumber::spatial_order(world.spheres.iter().map(|s| s.pos), world.size);
         self.bodies.clear();
         self.bodies.extend(
             self.order
@@ -245,6 +242,7 @@ impl<Q: EventQueue> EventDriven<Q> {
         self.mass.clear();
         self.mass
             .extend(self.order.iter().map(|&k| world.spheres[k as usize].mass));
+        self.sorted_at = self.stats.crossings + self.stats.relists;
         self.reschedule_all();
     }
 
@@ -470,6 +468,15 @@ impl<Q: EventQueue> EventDriven<Q> {
     }
 
     fn collide(&mut self, i: usize, j: usize, c: &mut Counters) {
+        // Lower world id first, whichever of the two predicted the contact
+        // (labels decide that on a tie): observers see the same contact
+        // whatever the labels. `resolve_pair` gives the same velocities
+        // either way round, bit for bit.
+        let (i, j) = if self.order[i] < self.order[j] {
+            (i, j)
+        } else {
+            (j, i)
+        };
         let mut a = self.bodies[i].sphere(self.mass[i]);
         let mut b = self.bodies[j].sphere(self.mass[j]);
         let before = a.vel;
@@ -533,6 +540,15 @@ impl<Q: EventQueue + Send> Model for EventDriven<Q> {
                 self.reorigin(world.time);
             }
             let target = end - self.origin;
+            // Once the spheres have crossed about a cell each, on average.
+            let moved = self.stats.crossings + self.stats.relists;
+            if self.valid
+                && !self.no_renumbering
+                && moved - self.sorted_at >= self.bodies.len().max(1) as u64
+            {
+                self.renumber();
+                self.sorted_at = moved;
+            }
             if !self.valid {
                 for b in &mut self.bodies {
                     b.advance(world.time - self.origin);

@@ -26,6 +26,8 @@ pub trait EventQueue: Default {
     }
     /// The earliest pending event: time and sphere (time infinite if none).
     fn peek(&self) -> (f64, usize);
+    /// Time of sphere `i`'s pending event.
+    fn time_of(&self, i: usize) -> f64;
     /// Subtract `shift` from every time (a new time origin).
     fn shift(&mut self, shift: f64);
     /// Bytes held on the heap.
@@ -75,6 +77,12 @@ fn step(keys: &mut [u64], ids: &mut [u32], mask: usize, k: usize, w: u64) -> u64
 }
 
 impl EventQueue for Tournament {
+    /// Time of sphere `i`'s pending event.
+    #[inline]
+    fn time_of(&self, i: usize) -> f64 {
+        time(self.keys[self.size + i])
+    }
+
     /// Bytes held on the heap.
     fn heap_bytes(&self) -> usize {
         self.keys.capacity() * 8 + self.ids.capacity() * 4
@@ -180,12 +188,6 @@ impl Tournament {
             return None;
         }
         Some((&mut self.keys[..len], &mut self.ids[..len], len - 1))
-    }
-
-    /// Time of sphere `i`'s pending event.
-    #[inline]
-    pub fn time_of(&self, i: usize) -> f64 {
-        time(self.keys[self.size + i])
     }
 }
 

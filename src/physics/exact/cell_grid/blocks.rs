@@ -7,6 +7,7 @@
 //! spheres beyond [`BLOCK`] in one cell wait in a map from the cell, so a
 //! cell costs its 16-byte block and nothing more.
 use crate::physics::exact::NONE;
+use crate::physics::exact::renumber::apply;
 use std::collections::HashMap;
 
 /// Spheres a cell's block holds (cells are about a diameter wide, so most
@@ -97,6 +98,23 @@ impl CellBlocks {
         }
         self.blocks[c][BLOCK] -= 1;
         self.at[i] = (NONE, NONE);
+    }
+
+    /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
+    /// every cell keeps its order.
+    pub fn relabel(&mut self, perm: &[u32], inv: &[u32]) {
+        for (old, &(c, k)) in self.at.iter().enumerate() {
+            if c == NONE {
+                continue;
+            }
+            let (k, new) = (k as usize, inv[old]);
+            if k < BLOCK {
+                self.blocks[c as usize][k] = new;
+            } else if let Some(o) = self.overflow.get_mut(&c) {
+                o[k - BLOCK] = new;
+            }
+        }
+        apply(&mut self.at, perm);
     }
 
     #[inline]

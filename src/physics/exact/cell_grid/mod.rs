@@ -16,6 +16,7 @@ pub mod blocks;
 use super::NONE;
 use super::body::Body;
 use super::large::{BIG_FACTOR, split_big, time_to_leave};
+use super::renumber::apply;
 use super::schedule::{Event, Kind};
 use blocks::CellBlocks;
 use glam::DVec3;
@@ -193,6 +194,17 @@ impl CellGrid {
         let k = &mut self.coord[i][axis];
         *k = if up { *k + 1 } else { *k - 1 };
         self.list.move_to(i, to);
+    }
+
+    /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
+    /// every cell keeps its order.
+    pub fn relabel(&mut self, perm: &[u32], inv: &[u32]) {
+        self.list.relabel(perm, inv);
+        apply(&mut self.coord, perm);
+        apply(&mut self.big_slot, perm);
+        for b in &mut self.bigs {
+            *b = inv[*b as usize];
+        }
     }
 
     /// A large sphere rescans from where it is now.

@@ -4,6 +4,7 @@
 //! gathers cells far more often, keeps its cells in
 //! [`CellBlocks`](crate::physics::exact::cell_grid::blocks::CellBlocks) instead.
 use crate::physics::exact::NONE;
+use crate::physics::exact::renumber::apply;
 
 #[derive(Clone, Debug, Default)]
 pub struct CellChains {
@@ -57,6 +58,19 @@ impl CellChains {
         }
         if n != NONE {
             self.prev[n as usize] = p;
+        }
+    }
+
+    /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
+    /// every chain keeps its order.
+    pub fn relabel(&mut self, perm: &[u32], inv: &[u32]) {
+        for v in [&mut self.head, &mut self.next, &mut self.prev] {
+            for x in v.iter_mut().filter(|x| **x != NONE) {
+                *x = inv[*x as usize];
+            }
+        }
+        for v in [&mut self.next, &mut self.prev, &mut self.cell] {
+            apply(v, perm);
         }
     }
 

@@ -19,6 +19,7 @@ pub mod chains;
 use super::NONE;
 use super::body::Body;
 use super::large::{BIG_FACTOR, split_big, time_to_leave};
+use super::renumber::{apply, apply_chunks};
 use chains::CellChains;
 use glam::DVec3;
 
@@ -159,6 +160,24 @@ impl Lists {
         }
     }
 
+    /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
+    /// every list keeps its order, so the `back` places hold.
+    fn relabel(&mut self, perm: &[u32], inv: &[u32]) {
+        apply_chunks(&mut self.flat, self.stride, perm);
+        apply(&mut self.len, perm);
+        apply(&mut self.slot, perm);
+        for i in 0..self.len.len() {
+            if self.slot[i] == NONE {
+                for l in self.of_mut(i) {
+                    l.j = inv[l.j as usize];
+                }
+            }
+        }
+        for l in self.big.iter_mut().flatten() {
+            l.j = inv[l.j as usize];
+        }
+    }
+
     fn grow(&mut self) {
         let old = self.stride;
         self.stride *= 2;
@@ -253,6 +272,17 @@ impl NeighbourLists {
             self.cells.move_to(i, self.cell_index(bodies[i].pos));
         }
         self.scan(i, bodies, |j| j != i);
+    }
+
+    /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
+    /// every list and cell keeps its order.
+    pub fn relabel(&mut self, perm: &[u32], inv: &[u32]) {
+        apply(&mut self.centre, perm);
+        self.lists.relabel(perm, inv);
+        self.cells.relabel(perm, inv);
+        for b in &mut self.bigs {
+            *b = inv[*b as usize];
+        }
     }
 
     #[inline]
