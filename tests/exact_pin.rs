@@ -37,7 +37,9 @@ fn checksum(mut w: World, dt: f64, steps: u64) -> (u64, u64, World) {
     let contacts = Arc::new(Mutex::new((Fnv::new(), 0u64)));
     let sink = Arc::clone(&contacts);
     // The grid of 446c9af.
-    let mut m = Exact::default().with_cells_per_sphere(16);
+    let mut m = Exact::default()
+        .with_cells_per_sphere(16)
+        .with_renumbering(true);
     m.set_observer(Some(Box::new(move |c| {
         let mut s = sink.lock().expect("observer lock");
         // The pair lower id first and no impulse: which of two simultaneous

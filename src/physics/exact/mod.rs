@@ -12,15 +12,15 @@
 //!   ([`neighbour_lists`]); both keep the few spheres far larger than the
 //!   bulk on a second level ([`large`]), so radii 100x apart stay cheap;
 //! - stale predictions detected by per-sphere collision counts ([`schedule`]);
-//! - spheres relabelled in space as they drift ([`renumber`]), so neighbours
-//!   sit together in memory; the world keeps every sphere at its id.
+//! - spheres sorted in space at load, and on request relabelled again as
+//!   they drift ([`renumber`]); the world keeps every sphere at its id.
 //!
 //! Time of impact comes from [`pair_toi`](crate::physics::contact::pair_toi)
 //! (stable quadratic, rounding guard: overlapping and approaching collides
 //! now, receding is left alone). Simultaneous events are processed in a
 //! fixed order: by the sphere whose prediction it is, in the model's
-//! internal order (sorted in space at load and again as the spheres drift,
-//! [`renumber`]: a pure function of the world and its history; a contact
+//! internal order (sorted in space at load, and, if asked, again as the
+//! spheres drift, [`renumber`]: a pure function of the world and its history; a contact
 //! taken by either of its spheres is the same contact, bit for bit, and is
 //! reported lower world id first); a sphere's own candidates tie its broad-phase
 //! event (relist or crossing) first, then walls, then partners in the order
@@ -139,8 +139,9 @@ pub struct EventDriven<Q: EventQueue> {
     valid: bool,
     cap: Option<u64>,
     cells_per_sphere: Option<u32>,
-    /// Keep the load's spatial order only (for measuring what renumbering buys).
-    no_renumbering: bool,
+    /// Sort the spheres in space again as they drift (off by default: it
+    /// measured slower, see docs/benchmarks.md "exact at scale").
+    renumbering: bool,
     /// Broad-phase events (crossings, relists) at the last spatial sort.
     sorted_at: u64,
     observer: Option<Observer>,
@@ -178,10 +179,10 @@ impl<Q: EventQueue> EventDriven<Q> {
         self
     }
 
-    /// Keep the spheres in the order the load gave them (default: sorted
-    /// again by cell as they drift), for comparing the two.
+    /// Sort the spheres by cell again as they drift (default: only at
+    /// load), for comparing the two.
     pub fn with_renumbering(mut self, on: bool) -> Self {
-        self.no_renumbering = !on;
+        self.renumbering = on;
         self
     }
 
@@ -543,7 +544,7 @@ impl<Q: EventQueue + Send> Model for EventDriven<Q> {
             // Once the spheres have crossed about a cell each, on average.
             let moved = self.stats.crossings + self.stats.relists;
             if self.valid
-                && !self.no_renumbering
+                && self.renumbering
                 && moved - self.sorted_at >= self.bodies.len().max(1) as u64
             {
                 self.renumber();

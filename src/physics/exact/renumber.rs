@@ -1,7 +1,9 @@
 //! Spatial renumbering: the event loop keeps its spheres in the order of
 //! their cells, so a sphere's neighbours sit close to it in every
 //! per-sphere array and a prediction touches few cache lines. The load
-//! sorts them; as they drift, [`EventDriven::renumber`] sorts them again.
+//! sorts them; as they drift, [`EventDriven::renumber`] sorts them again
+//! (when asked: `with_renumbering(true)`; at 100k and 1M spheres it cost
+//! more than it saved, see docs/benchmarks.md "exact at scale").
 //! Only labels change: every record moves with its sphere and keeps its
 //! value (and each cell and list keeps its order), and `order` maps the
 //! labels back to the world's ids, so the world, the CSV and the screen
