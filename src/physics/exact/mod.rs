@@ -469,28 +469,26 @@ impl<Q: EventQueue> EventDriven<Q> {
     }
 
     fn collide(&mut self, i: usize, j: usize, c: &mut Counters) {
-        // Lower world id first, whichever of the two predicted the contact
-        // (labels decide that on a tie): observers see the same contact
-        // whatever the labels. `resolve_pair` gives the same velocities
-        // either way round, bit for bit.
-        let (i, j) = if self.order[i] < self.order[j] {
-            (i, j)
-        } else {
-            (j, i)
-        };
         let mut a = self.bodies[i].sphere(self.mass[i]);
         let mut b = self.bodies[j].sphere(self.mass[j]);
-        let before = a.vel;
+        let before = [a.vel, b.vel];
         if resolve_pair(&mut a, &mut b) {
             c.sphere_collisions += 1;
             if let Some(f) = &mut self.observer {
+                // Lower world id first, whichever of the two predicted the
+                // contact (labels decide that on a tie; `resolve_pair` gives
+                // the same velocities either way round, bit for bit), so
+                // observers see the same contact whatever the labels.
+                let (ids, spheres) = ([self.order[i], self.order[j]], [&a, &b]);
+                let lo = usize::from(ids[1] < ids[0]);
+                let (p, q) = (spheres[lo], spheres[1 - lo]);
                 f(&Contact {
                     time: self.origin + self.bodies[i].t,
-                    i: self.order[i] as usize,
-                    j: self.order[j] as usize,
-                    pos_i: a.pos,
-                    pos_j: b.pos,
-                    impulse: a.mass * (a.vel - before).length(),
+                    i: ids[lo] as usize,
+                    j: ids[1 - lo] as usize,
+                    pos_i: p.pos,
+                    pos_j: q.pos,
+                    impulse: p.mass * (p.vel - before[lo]).length(),
                 });
             }
         }
