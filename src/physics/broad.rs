@@ -772,17 +772,22 @@ impl Grid {
             v.clear();
             // Counted here, added to the total now and then: one shared
             // counter touched per pair would cost more than the pair.
-            let (mine, told) = (Cell::new(0usize), Cell::new(0usize));
+            // The total is read then too: a unit that finds few pairs costs
+            // little, whatever the others found.
+            let (mine, told, over) = (Cell::new(0usize), Cell::new(0usize), Cell::new(false));
             let tell = || {
-                found.fetch_add(mine.get() - told.get(), Ordering::Relaxed);
+                let new = mine.get() - told.get();
+                let before = found.fetch_add(new, Ordering::Relaxed);
                 told.set(mine.get());
+                over.set(before + new > limit);
             };
             let go = || {
                 if mine.get() - told.get() >= LIMIT_FLUSH {
                     tell();
                 }
-                found.load(Ordering::Relaxed) <= limit
+                !over.get()
             };
+            over.set(found.load(Ordering::Relaxed) > limit);
             if go() {
                 this.unit_pairs(units[u], &go, &mut |i, j| {
                     if keep(i, j) {

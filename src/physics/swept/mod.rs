@@ -43,9 +43,10 @@ const REACH_SLACK: f64 = 1.0 + 1e-9;
 /// Candidate pairs per parallel block when sorting them into meeting and
 /// merely near.
 const PAIR_BLOCK: usize = 4096;
-/// The work budget of one step, in pair checks (pairs detection finds, and
-/// spheres a rescan looks at): a base plus so much per sphere. At about
-/// 10 ns a check (docs/benchmarks.md), 1 000 spheres get about a second.
+/// The work budget of one step, in pair checks (pairs detection finds,
+/// spheres a rescan looks at, weights per event: `cluster.rs`): a base plus
+/// so much per sphere, so the worst step of 1 000 spheres (120 M) costs
+/// under a second of CPU here (docs/benchmarks.md).
 const BUDGET_BASE: u64 = 20_000_000;
 const BUDGET_PER_SPHERE: u64 = 100_000;
 
