@@ -4,8 +4,8 @@
 //! drift over 10 million collisions, deepest overlap, escapes) print first.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap fails the run
 use ballpit::physics::exact::Exact;
-use ballpit::physics::exact::lattice;
 use ballpit::physics::{Model, Serial, World};
+use ballpit::scene::lattice;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::time::{Duration, Instant};
 

@@ -5,8 +5,8 @@
 //!
 //! `cargo run --release --example exact_rate -- 0.25 400000`
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap fails the run
-use ballpit::physics::exact::lattice::melted;
 use ballpit::physics::{Model, Serial};
+use ballpit::scene::lattice::melted;
 use std::time::Instant;
 
 fn main() {

@@ -15,9 +15,9 @@
 //! above the statistical and finite-size errors here (under 1 %) and well
 //! below what missing 5 % of the collisions does to both figures.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
-use ballpit::physics::exact::lattice::lattice_world;
 use ballpit::physics::exact::{Contact, Exact};
 use ballpit::physics::{Counters, Model, Serial};
+use ballpit::scene::lattice::lattice_world;
 use glam::DVec3;
 use std::sync::{Arc, Mutex};
 

@@ -18,8 +18,8 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use assert_cmd::Command;
 use ballpit::physics::exact::Exact;
-use ballpit::physics::exact::lattice::lattice_world;
 use ballpit::physics::{Model, ModelKind, Serial, Sphere, World};
+use ballpit::scene::lattice::lattice_world;
 use glam::DVec3;
 
 const ENERGY: f64 = 1e-10;

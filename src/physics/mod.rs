@@ -15,7 +15,6 @@ mod detect;
 pub mod discrete;
 pub mod edit;
 #[allow(
-    clippy::default_trait_access,
     clippy::doc_markdown,
     clippy::expect_used,
     clippy::if_not_else,
@@ -35,7 +34,8 @@ pub mod sphere;
 #[allow(
     clippy::expect_used,
     clippy::return_self_not_must_use,
-    clippy::single_match_else
+    clippy::single_match_else,
+    clippy::too_many_lines
 )]
 pub mod swept;
 pub mod world;

@@ -23,7 +23,7 @@
 //! and whatever runs them: clusters that cannot touch each other have no
 //! events in common, events within one are taken in the same order (ties by
 //! sphere id), and totals are summed in a fixed order.
-use super::cluster::{Kink, Member, Run, Shared};
+use super::cluster::{Coarse, Kink, Member, Run, Shared};
 use super::{NONE, path_ball};
 use crate::physics::broad::Grid;
 use crate::physics::exec::{Exec, Serial, next_blocks};
@@ -44,8 +44,9 @@ const PARALLEL_ROUNDS: usize = 8;
 /// What one block of clusters left.
 #[derive(Default)]
 struct BlockOut {
-    /// Finished clusters: (capped, how many of `members` are theirs).
-    done: Vec<(bool, u32)>,
+    /// Finished clusters: (why capped, how many of `members` are theirs,
+    /// the work the run did).
+    done: Vec<(Option<Coarse>, u32, u64)>,
     members: Vec<Member>,
     /// The members' turns (`Member::kink0` indexes here).
     kinks: Vec<Kink>,
@@ -125,7 +126,7 @@ pub(super) struct Rounds {
     dirty: Vec<bool>,
     /// By slot: the member's result from its cluster's last finished run.
     out: Vec<Option<Member>>,
-    capped: Vec<bool>,
+    capped: Vec<Option<Coarse>>,
     /// Slot → root slot, fixed during a round (the cluster's name).
     cluster_of: Vec<u32>,
     order: Vec<u32>,
@@ -150,6 +151,8 @@ pub(super) struct Rounds {
     overlap: Grid,
     overlap_pairs: Vec<(u32, u32)>,
     pub stats: RoundStats,
+    /// Work (see `Run::work`) done by the last `run`'s cluster runs.
+    pub work: u64,
     /// Run every step as one absorbing cluster (the plain serial loop),
     /// whatever the lanes.
     pub serial_only: bool,
@@ -157,10 +160,10 @@ pub(super) struct Rounds {
 
 impl Rounds {
     /// The results of the last `run`: every sphere that had events, with
-    /// its run's end of the step and whether the run hit the event cap, in
-    /// sphere order (so totals summed in this order are the serial loop's
-    /// to the bit, however the clusters fell).
-    pub fn results(&self) -> impl Iterator<Item = (&Member, bool)> {
+    /// its run's end of the step and whether (and why) the run was capped,
+    /// in sphere order (so totals summed in this order are the serial
+    /// loop's to the bit, however the clusters fell).
+    pub fn results(&self) -> impl Iterator<Item = (&Member, Option<Coarse>)> {
         self.in_order.iter().map(|&s| {
             let s = s as usize;
             let m = self.out[s].as_ref();
@@ -172,6 +175,9 @@ impl Rounds {
     /// meet within `dt`, `near` pairs whose balls overlap but do not meet,
     /// `hits` the spheres that reach a wall. Each involved sphere's end of
     /// the step is then among [`Rounds::results`]; `spheres` is not changed.
+    /// The runs may do `budget` work in all, each round's split over its
+    /// runs by their members (so not by lanes); [`Rounds::work`] says how
+    /// much they did.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &mut self,
@@ -183,7 +189,9 @@ impl Rounds {
         meets: &[(u32, u32)],
         near: &[(u32, u32)],
         hits: &[u32],
+        budget: u64,
     ) {
+        self.work = 0;
         let serial = self.start(spheres.len(), meets, near, hits);
         let mut round = 0;
         loop {
@@ -223,6 +231,8 @@ impl Rounds {
                 partners: &self.partners,
                 size,
                 dt,
+                // A round's runs start with at most every slot between them.
+                work_per_member: budget.saturating_sub(self.work) / self.ids.len().max(1) as u64,
             };
             self.run_clusters(lanes, &sh, absorb);
             self.collect();
@@ -306,7 +316,7 @@ impl Rounds {
         self.out.clear();
         self.out.resize(m, None);
         self.capped.clear();
-        self.capped.resize(m, false);
+        self.capped.resize(m, None);
         self.ran.clear();
         self.ran.resize(m, NONE);
         self.paths.clear();
@@ -397,7 +407,7 @@ impl Rounds {
         self.dirty.push(true);
         self.dirty_roots.push(k);
         self.out.push(None);
-        self.capped.push(false);
+        self.capped.push(None);
         self.ran.push(NONE);
         k
     }
@@ -590,7 +600,7 @@ impl Rounds {
                     }));
                     out.cross.extend_from_slice(&run.cross);
                     let len = (out.members.len() - before) as u32;
-                    out.done.push((run.capped, len));
+                    out.done.push((run.capped, len, run.work));
                 }
             }
         });
@@ -609,7 +619,8 @@ impl Rounds {
         for block in &outs[..self.todo.len().div_ceil(CLUSTER_BLOCK)] {
             let out = block.lock();
             let mut k = 0usize;
-            for &(capped, len) in &out.done {
+            for &(capped, len, work) in &out.done {
+                self.work += work;
                 let members = &out.members[k..k + len as usize];
                 k += len as usize;
                 // Spheres a run took in are its members now.
@@ -786,7 +797,7 @@ impl Rounds {
 /// The paths the finished runs took, by slot.
 struct Paths<'a> {
     out: &'a [Option<Member>],
-    capped: &'a [bool],
+    capped: &'a [Option<Coarse>],
     turns: &'a [Kink],
     spheres: &'a [Sphere],
     dt: f64,
@@ -797,7 +808,7 @@ impl Paths<'_> {
     /// distance during the step. A capped run's path is not fully known: it
     /// meets everyone.
     fn meet(&self, a: usize, b: usize) -> bool {
-        if self.capped[a] || self.capped[b] {
+        if self.capped[a].is_some() || self.capped[b].is_some() {
             return true;
         }
         let path = |s: usize| {

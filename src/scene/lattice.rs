@@ -3,8 +3,8 @@
 //! lattice (up to packing π/6 ≈ 0.52 when N is a cube) with Gaussian
 //! velocities, then the dynamics melts the lattice within a few collisions
 //! per sphere.
-use super::Exact;
 use crate::error::BadInput;
+use crate::physics::exact::Exact;
 use crate::physics::{Model, Serial, Sphere, World};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
@@ -65,6 +65,6 @@ pub fn melted(n: usize, packing: f64, per_step: f64) -> Result<(World, Exact, f6
     let (c0, t0) = (w.counters.sphere_collisions, w.time);
     m.advance(&mut w, 0.01, 5, &Serial);
     let rate = (w.counters.sphere_collisions - c0) as f64 / (w.time - t0);
-    w.counters = Default::default();
+    w.counters = crate::physics::Counters::default();
     Ok((w, m, per_step / rate))
 }
