@@ -140,7 +140,8 @@ pub struct Engine {
     home: Option<Box<Frame>>,
     in_flight: bool,
     front: Snapshot,
-    initial: World,
+    /// The scene as it started, for Reset (`None`: headless, no Reset).
+    initial: Option<World>,
     settings: Settings,
     pending: Vec<Command>,
     worker: Worker,
@@ -160,17 +161,35 @@ impl Engine {
     /// An engine running a model of the caller's (tests, instrumented runs).
     pub fn with_model(
         world: World,
+        settings: Settings,
+        model: Box<dyn Model>,
+    ) -> anyhow::Result<Engine> {
+        Engine::build(world, settings, model, false)
+    }
+
+    /// An engine for runs without a screen (`bench`): its snapshots carry
+    /// the figures but not the spheres, and it keeps no copy of the start,
+    /// so Reset only leaves a notice. The world is then held once.
+    pub fn headless(world: World, settings: Settings) -> anyhow::Result<Engine> {
+        let model = settings.model.build();
+        Engine::build(world, settings, model, true)
+    }
+
+    fn build(
+        world: World,
         mut settings: Settings,
         model: Box<dyn Model>,
+        headless: bool,
     ) -> anyhow::Result<Engine> {
         settings.threads = settings.threads.clamp(1, MAX_THREADS);
         let serial: SharedExec = Arc::new(Serial);
-        let frame = Frame::new(world.clone(), model, serial.clone(), settings);
+        let initial = (!headless).then(|| world.clone());
+        let frame = Frame::new(world, model, serial.clone(), settings, !headless);
         Ok(Engine {
             front: frame.snap.clone(),
             home: Some(Box::new(frame)),
             in_flight: false,
-            initial: world,
+            initial,
             settings,
             pending: Vec::new(),
             worker: Worker::spawn()?,
@@ -249,6 +268,12 @@ impl Engine {
     /// The world, unless a frame is in flight or the physics failed.
     pub fn try_world(&self) -> Option<&World> {
         self.home.as_ref().map(|f| &f.world)
+    }
+
+    /// The world, moved out without a copy (as `try_world`: `None` while a
+    /// frame is in flight or after the physics failed).
+    pub fn into_world(mut self) -> Option<World> {
+        self.home.take().map(|f| f.world)
     }
 
     /// Whether `finish_frame` would return without waiting: no frame is in
@@ -343,14 +368,13 @@ impl Engine {
                         continue;
                     }
                     let w = &mut frame.world;
-                    let radius = edit::typical_radius(w)
-                        .or_else(|| edit::typical_radius(&self.initial))
-                        .unwrap_or(0.02 * w.size);
-                    let speed = if w.spheres.is_empty() {
-                        edit::rms_speed(&self.initial)
-                    } else {
-                        edit::rms_speed(w)
+                    // An emptied box takes new spheres like the start's.
+                    let like = match &self.initial {
+                        Some(start) if w.spheres.is_empty() => start,
+                        _ => &*w,
                     };
+                    let radius = edit::typical_radius(like).unwrap_or(0.02 * w.size);
+                    let speed = edit::rms_speed(like);
                     frame.notice = edit::set_count(w, n, radius, speed, &mut self.rng);
                     self.edited(frame);
                 }
@@ -359,7 +383,11 @@ impl Engine {
                     self.edited(frame);
                 }
                 Command::Reset => {
-                    frame.world = self.initial.clone();
+                    let Some(start) = &self.initial else {
+                        frame.notice = Some("reset: a headless engine keeps no start".into());
+                        continue;
+                    };
+                    frame.world = start.clone();
                     frame.world.touch();
                     frame.model = self.settings.model.build();
                     frame.notice = None;

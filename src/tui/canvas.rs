@@ -130,8 +130,11 @@ impl Raster {
 
     fn spheres(&mut self, spheres: &[SphereView], scene: &Scene, proj: &Projection) {
         let (near, far) = proj.depth_range();
-        let mean_sq =
-            spheres.iter().map(|s| s.speed * s.speed).sum::<f64>() / spheres.len().max(1) as f64;
+        let mean_sq = spheres
+            .iter()
+            .map(|s| f64::from(s.speed).powi(2))
+            .sum::<f64>()
+            / spheres.len().max(1) as f64;
         // Twice the rms speed is "hot": a Maxwell gas spreads over the ramp.
         let hot = 2.0 * mean_sq.sqrt();
         let mut order = std::mem::take(&mut self.order);
@@ -139,7 +142,7 @@ impl Raster {
         order.clear();
         projected.clear();
         for s in spheres {
-            let p = proj.project(s.pos);
+            let p = proj.project(s.pos.map(f64::from));
             if let Some(p) = p {
                 // Depths are positive, so their bits sort like the numbers;
                 // inverted, the farthest comes first.
@@ -161,12 +164,12 @@ impl Raster {
             let i = (key & 0xffff_ffff) as usize;
             let (s, p) = (&spheres[i], projected[i]);
             let t = match scene.style.ramp() {
-                Ramp::Speed if hot > 0.0 => s.speed / hot,
+                Ramp::Speed if hot > 0.0 => f64::from(s.speed) / hot,
                 Ramp::Speed => 0.0,
                 Ramp::Depth => 1.0 - (p.depth - near) / (far - near),
             };
             let level = (t.clamp(0.0, 1.0) * f64::from(RAMP_LEVELS - 1) + 0.5) as u8;
-            let r = s.radius * p.unit; // cell widths
+            let r = f64::from(s.radius) * p.unit; // cell widths
             self.disc(p.x, p.y, r / pw, r / ph, p.depth as f32, level, light, ring);
         }
         self.order = order;
@@ -405,7 +408,11 @@ mod tests {
     }
 
     fn sphere(pos: [f64; 3], radius: f64, speed: f64) -> SphereView {
-        SphereView { pos, radius, speed }
+        SphereView {
+            pos: pos.map(|x| x as f32),
+            radius: radius as f32,
+            speed: speed as f32,
+        }
     }
 
     #[test]
