@@ -86,7 +86,11 @@ fn main() -> anyhow::Result<()> {
         .unwrap_or_default();
     let status: Vec<&str> = text
         .lines()
-        .filter(|l| l.contains("fps") || l.contains("physics") || l.contains("draw"))
+        .filter(|l| {
+            ["fps", "physics", "render", "steps/s"]
+                .iter()
+                .any(|w| l.contains(w))
+        })
         .collect();
     println!(
         "{:.1} frames/s counted over {dt:.1} s ({} frames, {:.0} KB/s), first frame after {:.2} s",
