@@ -1,9 +1,8 @@
-//! What the main thread spends per frame on a large scene besides the
-//! physics: the snapshot's copy of the spheres (on the calling thread here)
-//! and the whole screen drawn into ratatui's TestBackend (projection,
-//! depth order, discs, widgets, buffer diff; no terminal writes). On-CPU
-//! time of this thread (Linux schedstat), so waiting for a core does not
-//! count; for instruction counts run it under callgrind with
+//! What the main thread spends drawing one frame of a large scene: the
+//! whole screen into ratatui's `TestBackend` (projection, depth test,
+//! discs, widgets, buffer diff; no terminal writes). On-CPU time of this
+//! thread (Linux schedstat), so waiting for a core does not count; for
+//! instruction counts run it under callgrind with
 //! `--toggle-collect='*Raster*draw*'`.
 //!
 //!     cargo run --release --example canvas_cost -- [COUNT [RADIUS [FRAMES [COLSxROWS]]]]
@@ -28,7 +27,7 @@ fn on_cpu() -> Option<u64> {
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let count: usize = args.first().map_or(Ok(100_000), |a| a.parse())?;
-    let radius: f64 = args.get(1).map_or(Ok(0.002285), |a| a.parse())?;
+    let radius: f64 = args.get(1).map_or(Ok(0.002_285), |a| a.parse())?;
     let frames: u32 = args.get(2).map_or(Ok(30), |a| a.parse())?;
     let (w, h) = args
         .get(3)

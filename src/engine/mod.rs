@@ -170,6 +170,9 @@ impl Engine {
     /// An engine for runs without a screen (`bench`): its snapshots carry
     /// the figures but not the spheres, and it keeps no copy of the start,
     /// so Reset only leaves a notice. The world is then held once.
+    ///
+    /// # Errors
+    /// When the `physics` thread cannot be started.
     pub fn headless(world: World, settings: Settings) -> anyhow::Result<Engine> {
         let model = settings.model.build();
         Engine::build(world, settings, model, true)
@@ -272,6 +275,7 @@ impl Engine {
 
     /// The world, moved out without a copy (as `try_world`: `None` while a
     /// frame is in flight or after the physics failed).
+    #[must_use]
     pub fn into_world(mut self) -> Option<World> {
         self.home.take().map(|f| f.world)
     }

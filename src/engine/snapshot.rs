@@ -126,7 +126,7 @@ impl Snapshot {
         if views {
             self.spheres.resize(sp.len(), SphereView::default());
             for_each_chunk(exec, &mut self.spheres, VIEW_BLOCK, &|b, c| {
-                scan(b, Some(c))
+                scan(b, Some(c));
             });
         } else {
             self.spheres = Vec::new();
