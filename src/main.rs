@@ -89,10 +89,19 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 )
                 .into());
             }
-            let world = scene::build_world_for(&cli.scene.spec(), Some(settings.model))?;
+            let spec = cli.scene.spec();
+            let world = scene::build_world_for(&spec, Some(settings.model))?;
             // The app can switch to any model: plan for the hungriest.
             fits(world.spheres.len(), None)?;
-            ballpit::tui::run(world, settings, opts)
+            // A preset is made again for Reset rather than kept; a file's
+            // spheres are kept (the file may change meanwhile).
+            let name = spec.scene.clone().unwrap_or_default();
+            let rebuild = (!(name.ends_with(".csv") || name.ends_with(".toml"))).then(|| {
+                let model = settings.model;
+                Box::new(move || Ok(scene::build_world_for(&spec, Some(model))?))
+                    as ballpit::engine::Rebuild
+            });
+            ballpit::tui::run_with_start(world, settings, opts, rebuild)
         }
     }
 }

@@ -15,8 +15,9 @@ pub fn sphere_bytes(model: ModelKind) -> u64 {
 }
 
 /// What the app holds a sphere on top of the model's run, with the same
-/// margin: the start kept for Reset (64 bytes) and the front and back
-/// screen views (20 bytes each).
+/// margin: the start kept for Reset (64 bytes; only for a scene from a
+/// file, a preset is made again) and the front and back screen views (20
+/// bytes each).
 const SCREEN_BYTES: u64 = 130;
 
 /// What the process takes before any sphere: code, threads, buffers.

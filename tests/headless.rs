@@ -188,3 +188,56 @@ fn views_are_the_spheres_to_single_precision() {
     let widest = w.spheres.iter().map(|s| s.radius).fold(0.0, f64::max);
     assert_eq!(snap.max_radius, Some(widest));
 }
+
+#[test]
+fn a_rebuilt_start_comes_back_bit_for_bit_or_not_at_all() {
+    use ballpit::scene::{SceneSpec, build_world_for};
+    let spec = SceneSpec {
+        count: Some(2000),
+        seed: Some(9),
+        ..Default::default()
+    };
+    let model = ModelKind::Swept;
+    let first = build_world_for(&spec, Some(model)).unwrap();
+    let edit_and_reset = |e: &mut Engine| {
+        for cmd in [Command::SetCount(2300), Command::SetRadius(0.01)] {
+            e.command(cmd);
+            e.start_frame().unwrap();
+            e.finish_frame().unwrap();
+        }
+        let edited = bits(e.world());
+        e.command(Command::Reset);
+        e.command(Command::SetTick(0));
+        e.start_frame().unwrap();
+        e.finish_frame().unwrap();
+        edited
+    };
+    let s = settings(model, Threading::Worker);
+    let again = spec.clone();
+    let rebuild = Box::new(move || Ok(build_world_for(&again, Some(model))?));
+    let mut e = Engine::with_rebuild(first.clone(), s, rebuild).unwrap();
+    let edited = edit_and_reset(&mut e);
+    assert_ne!(edited, bits(&first));
+    assert_eq!(bits(e.world()), bits(&first));
+    assert_eq!(e.snapshot().notice, None);
+    check_invariants(&first, e.snapshot());
+    // A description that no longer gives the start: Reset says so and the
+    // world stays as it was.
+    let other = SceneSpec {
+        seed: Some(10),
+        ..spec
+    };
+    let rebuild = Box::new(move || Ok(build_world_for(&other, Some(model))?));
+    let mut e = Engine::with_rebuild(first.clone(), s, rebuild).unwrap();
+    let edited = edit_and_reset(&mut e);
+    assert_eq!(bits(e.world()), edited);
+    let notice = e.snapshot().notice.clone().unwrap_or_default();
+    assert!(notice.contains("rebuilt differently"), "{notice}");
+    // One that fails: the notice says why.
+    let rebuild = Box::new(|| Err(anyhow::anyhow!("scene file gone")));
+    let mut e = Engine::with_rebuild(first.clone(), s, rebuild).unwrap();
+    let edited = edit_and_reset(&mut e);
+    assert_eq!(bits(e.world()), edited);
+    let notice = e.snapshot().notice.clone().unwrap_or_default();
+    assert!(notice.contains("scene file gone"), "{notice}");
+}

@@ -1,5 +1,6 @@
 //! The real binary with 100 000 spheres in a pseudo-terminal: it draws
-//! frames, the physics advances, and keys are answered. No speed figure is
+//! frames, the physics advances, keys are answered, and Reset makes the
+//! preset again. No speed figure is
 //! asserted (the machine may be loaded); the deadlines are generous.
 // Each test file uses part of the shared helpers.
 #[allow(dead_code)]
@@ -57,6 +58,16 @@ fn a_hundred_thousand_spheres_are_drawn_and_keys_answered() {
     app.wait_for("the next style", 20.0, |s| {
         readout(s, "style").is_some_and(|v| v.starts_with("braille, depth"))
     });
+    // Halving the count, then Reset: the preset is made again, all of it.
+    app.send("n");
+    app.wait_for("half the spheres", 20.0, |s| {
+        readout(s, "count") == Some("50000")
+    });
+    app.send("0");
+    let s = app.wait_for("the start again", 20.0, |s| {
+        readout(s, "count") == Some("100000")
+    });
+    assert!(!s.contains("reset:"), "{s}");
     app.send("q");
     let st = app.wait_exit(20.0).expect("q ends the app");
     assert!(st.success(), "exit {st:?}");

@@ -17,15 +17,18 @@
 mod frame;
 mod pool;
 mod snapshot;
+mod start;
 mod worker;
 
 pub use pool::{PoolExec, SPLIT_NAMES, SplitExec};
 pub use snapshot::{Snapshot, SphereView};
+pub use start::Rebuild;
 
 use crate::physics::{Model, ModelKind, Serial, World, edit};
 use frame::{Frame, SharedExec};
 use rand::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
+use start::Start;
 use std::fmt;
 use std::str::FromStr;
 use std::sync::Arc;
@@ -140,8 +143,12 @@ pub struct Engine {
     home: Option<Box<Frame>>,
     in_flight: bool,
     front: Snapshot,
-    /// The scene as it started, for Reset (`None`: headless, no Reset).
-    initial: Option<World>,
+    /// The scene as it started, for Reset.
+    start: Start,
+    /// The start's median radius and rms speed, for spheres added to an
+    /// emptied box.
+    start_radius: Option<f64>,
+    start_speed: f64,
     settings: Settings,
     pending: Vec<Command>,
     worker: Worker,
@@ -164,7 +171,24 @@ impl Engine {
         settings: Settings,
         model: Box<dyn Model>,
     ) -> anyhow::Result<Engine> {
-        Engine::build(world, settings, model, false)
+        let start = Start::Kept(world.clone());
+        Engine::build(world, settings, model, start, true)
+    }
+
+    /// An engine that rebuilds the start on Reset instead of keeping a copy
+    /// (a preset scene: `rebuild` must give the same world each time; Reset
+    /// checks, and leaves a notice if not).
+    ///
+    /// # Errors
+    /// When the `physics` thread cannot be started.
+    pub fn with_rebuild(
+        world: World,
+        settings: Settings,
+        rebuild: Rebuild,
+    ) -> anyhow::Result<Engine> {
+        let model = settings.model.build();
+        let start = Start::rebuilt(&world, rebuild);
+        Engine::build(world, settings, model, start, true)
     }
 
     /// An engine for runs without a screen (`bench`): its snapshots carry
@@ -175,24 +199,27 @@ impl Engine {
     /// When the `physics` thread cannot be started.
     pub fn headless(world: World, settings: Settings) -> anyhow::Result<Engine> {
         let model = settings.model.build();
-        Engine::build(world, settings, model, true)
+        Engine::build(world, settings, model, Start::Dropped, false)
     }
 
     fn build(
         world: World,
         mut settings: Settings,
         model: Box<dyn Model>,
-        headless: bool,
+        start: Start,
+        views: bool,
     ) -> anyhow::Result<Engine> {
         settings.threads = settings.threads.clamp(1, MAX_THREADS);
         let serial: SharedExec = Arc::new(Serial);
-        let initial = (!headless).then(|| world.clone());
-        let frame = Frame::new(world, model, serial.clone(), settings, !headless);
+        let (start_radius, start_speed) = (edit::typical_radius(&world), edit::rms_speed(&world));
+        let frame = Frame::new(world, model, serial.clone(), settings, views);
         Ok(Engine {
             front: frame.snap.clone(),
             home: Some(Box::new(frame)),
             in_flight: false,
-            initial,
+            start,
+            start_radius,
+            start_speed,
             settings,
             pending: Vec::new(),
             worker: Worker::spawn()?,
@@ -373,12 +400,12 @@ impl Engine {
                     }
                     let w = &mut frame.world;
                     // An emptied box takes new spheres like the start's.
-                    let like = match &self.initial {
-                        Some(start) if w.spheres.is_empty() => start,
-                        _ => &*w,
+                    let (radius, speed) = if w.spheres.is_empty() {
+                        (self.start_radius, self.start_speed)
+                    } else {
+                        (edit::typical_radius(w), edit::rms_speed(w))
                     };
-                    let radius = edit::typical_radius(like).unwrap_or(0.02 * w.size);
-                    let speed = edit::rms_speed(like);
+                    let radius = radius.unwrap_or(0.02 * w.size);
                     frame.notice = edit::set_count(w, n, radius, speed, &mut self.rng);
                     self.edited(frame);
                 }
@@ -387,11 +414,13 @@ impl Engine {
                     self.edited(frame);
                 }
                 Command::Reset => {
-                    let Some(start) = &self.initial else {
-                        frame.notice = Some("reset: a headless engine keeps no start".into());
-                        continue;
-                    };
-                    frame.world = start.clone();
+                    match self.start.world() {
+                        Ok(w) => frame.world = w,
+                        Err(why) => {
+                            frame.notice = Some(why);
+                            continue;
+                        }
+                    }
                     frame.world.touch();
                     frame.model = self.settings.model.build();
                     frame.notice = None;

@@ -10,7 +10,7 @@ use super::theme::Palette;
 use super::writer::Output;
 use super::{Options, input, reader};
 use crate::cpu::{CpuReport, Sampler};
-use crate::engine::{Command, Engine, Settings, Snapshot};
+use crate::engine::{Command, Engine, Rebuild, Settings, Snapshot};
 use crate::error::BadInput;
 use crate::physics::World;
 use anyhow::{Context, anyhow};
@@ -27,6 +27,17 @@ const SAMPLE_PERIOD: Duration = Duration::from_secs(1);
 
 /// Open the screen on `world` and run until the user quits.
 pub fn run(world: World, settings: Settings, opts: Options) -> anyhow::Result<()> {
+    run_with_start(world, settings, opts, None)
+}
+
+/// As [`run`]; with `rebuild`, Reset makes the start again from the scene's
+/// description instead of the engine keeping a copy of the spheres.
+pub fn run_with_start(
+    world: World,
+    settings: Settings,
+    opts: Options,
+    rebuild: Option<Rebuild>,
+) -> anyhow::Result<()> {
     if !(opts.fps.is_finite() && opts.fps > 0.0 && opts.fps <= 1000.0) {
         return Err(BadInput(format!(
             "--fps must be greater than 0 and at most 1000, got {}",
@@ -54,7 +65,10 @@ pub fn run(world: World, settings: Settings, opts: Options) -> anyhow::Result<()
         world.spheres.iter().map(|s| s.radius).fold(0.0, f64::max),
         opts.fps,
     );
-    let engine = Engine::new(world, settings)?;
+    let engine = match rebuild {
+        Some(r) => Engine::with_rebuild(world, settings, r)?,
+        None => Engine::new(world, settings)?,
+    };
 
     let (tx, rx) = crossbeam_channel::unbounded();
     let guard = Guard::enter(tx.clone()).context("cannot set up the terminal")?;
