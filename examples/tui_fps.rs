@@ -1,6 +1,7 @@
 //! Frames per second of the real app in a pseudo-terminal: counts the
 //! synchronized-output frames (DEC 2026) the binary writes over a window
-//! and reads the fps and physics figures its status line shows at the end.
+//! and reads the fps and physics figures its status line shows at the end,
+//! and the app's peak resident memory.
 //! Run `cargo build --release` first, then
 //!
 //!     cargo run --release --example tui_fps -- SECS COLSxROWS [BALLPIT ARGS...]
@@ -101,6 +102,18 @@ fn main() -> anyhow::Result<()> {
     );
     for l in status {
         println!("  {}", l.trim_end());
+    }
+    // The app's peak resident memory so far (Linux).
+    let hwm = child
+        .process_id()
+        .and_then(|pid| std::fs::read_to_string(format!("/proc/{pid}/status")).ok())
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .map(str::to_string)
+        });
+    if let Some(l) = hwm {
+        println!("  {l}");
     }
     done.store(true, Ordering::Relaxed);
     writer.write_all(b"q")?;
