@@ -85,14 +85,6 @@ fn main() -> anyhow::Result<()> {
         .lock()
         .map(|p| p.screen().contents())
         .unwrap_or_default();
-    let status: Vec<&str> = text
-        .lines()
-        .filter(|l| {
-            ["fps", "physics", "render", "steps/s"]
-                .iter()
-                .any(|w| l.contains(w))
-        })
-        .collect();
     println!(
         "{:.1} frames/s counted over {dt:.1} s ({} frames, {:.0} KB/s), first frame after {:.2} s",
         (f1 - f0) as f64 / dt,
@@ -100,21 +92,7 @@ fn main() -> anyhow::Result<()> {
         (b1 - b0) as f64 / dt / 1e3,
         start_up.as_secs_f64()
     );
-    for l in status {
-        println!("  {}", l.trim_end());
-    }
-    // The app's peak resident memory so far (Linux).
-    let hwm = child
-        .process_id()
-        .and_then(|pid| std::fs::read_to_string(format!("/proc/{pid}/status")).ok())
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .map(str::to_string)
-        });
-    if let Some(l) = hwm {
-        println!("  {l}");
-    }
+    print_readouts(&text, child.process_id());
     done.store(true, Ordering::Relaxed);
     writer.write_all(b"q")?;
     writer.flush()?;
@@ -130,4 +108,26 @@ fn main() -> anyhow::Result<()> {
     drop(pty.master);
     let _ = read.join();
     Ok(())
+}
+
+/// The status lines about speed, and the app's peak resident memory so far
+/// (Linux).
+fn print_readouts(text: &str, pid: Option<u32>) {
+    let wanted = ["fps", "physics", "render", "steps/s"];
+    for l in text
+        .lines()
+        .filter(|l| wanted.iter().any(|w| l.contains(w)))
+    {
+        println!("  {}", l.trim_end());
+    }
+    let hwm = pid
+        .and_then(|pid| std::fs::read_to_string(format!("/proc/{pid}/status")).ok())
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .map(str::to_string)
+        });
+    if let Some(l) = hwm {
+        println!("  {l}");
+    }
 }

@@ -95,8 +95,12 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             fits(world.spheres.len(), None)?;
             // A preset is made again for Reset rather than kept; a file's
             // spheres are kept (the file may change meanwhile).
-            let name = spec.scene.clone().unwrap_or_default();
-            let rebuild = (!(name.ends_with(".csv") || name.ends_with(".toml"))).then(|| {
+            let from_file = spec.scene.as_deref().is_some_and(|s| {
+                std::path::Path::new(s).extension().is_some_and(|e| {
+                    e.eq_ignore_ascii_case("csv") || e.eq_ignore_ascii_case("toml")
+                })
+            });
+            let rebuild = (!from_file).then(|| {
                 let model = settings.model;
                 Box::new(move || Ok(scene::build_world_for(&spec, Some(model))?))
                     as ballpit::engine::Rebuild
