@@ -32,6 +32,7 @@ use start::Start;
 use std::fmt;
 use std::str::FromStr;
 use std::sync::Arc;
+pub use worker::Notify;
 use worker::Worker;
 
 /// Where the physics runs (docs/design.md, Threading).
@@ -311,6 +312,12 @@ impl Engine {
     /// flight, or the one in flight is done.
     pub fn frame_ready(&self) -> bool {
         !self.in_flight || self.worker.ready()
+    }
+
+    /// Call `f` (on the `physics` thread) whenever a threaded frame is done,
+    /// so a caller waiting on something else can collect it at once.
+    pub fn set_notify(&self, f: Notify) {
+        self.worker.set_notify(f);
     }
 
     /// Whether a threaded frame is being computed.

@@ -71,6 +71,12 @@ pub fn run_with_start(
     };
 
     let (tx, rx) = crossbeam_channel::unbounded();
+    // A frame slower than the frame period is collected when it is done,
+    // not at the next period's start.
+    let done = tx.clone();
+    engine.set_notify(Box::new(move || {
+        let _ = done.send(Msg::PhysicsDone);
+    }));
     let guard = Guard::enter(tx.clone()).context("cannot set up the terminal")?;
     let signals = guard::spawn_signals(tx.clone())?;
     reader::spawn_input(tx.clone())?;
@@ -121,6 +127,9 @@ struct FrameLoop {
     pending: bool,
     /// A frame was started and not finished; whether it applied commands.
     in_flight: Option<bool>,
+    /// A period began while the physics was still busy: its frame is drawn
+    /// as soon as the physics is done.
+    late: bool,
     /// Something on screen would change.
     dirty: bool,
     window: Window,
@@ -183,6 +192,7 @@ impl FrameLoop {
             sent_tick,
             pending: false,
             in_flight: None,
+            late: false,
             dirty: true,
             window: Window {
                 start: Some(Instant::now()),
@@ -234,6 +244,10 @@ impl FrameLoop {
                 let period = Duration::from_secs_f64(1.0 / self.state.fps);
                 next_frame = later(next_frame, period, now);
                 self.frame()?;
+            } else if self.late && self.engine.frame_ready() {
+                // In place of the frame the physics missed: never more
+                // frames than periods.
+                self.frame()?;
             } else {
                 self.present()?;
             }
@@ -262,6 +276,7 @@ impl FrameLoop {
                 self.pacer.written();
                 Ok(false)
             }
+            Msg::PhysicsDone => Ok(false),
             Msg::Resize => {
                 self.aspect = cell_aspect();
                 self.terminal.autoresize()?;
@@ -282,8 +297,10 @@ impl FrameLoop {
         if self.in_flight.is_some() && !self.engine.frame_ready() {
             // The physics is slower than the frame rate: keep drawing and
             // answering keys on the last snapshot rather than wait for it.
+            self.late = true;
             return self.present();
         }
+        self.late = false;
         if let Some(applied) = self.in_flight.take() {
             let snap = self.engine.finish_frame()?;
             self.window.steps += snap.steps;
