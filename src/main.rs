@@ -89,10 +89,23 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 )
                 .into());
             }
-            let world = scene::build_world_for(&cli.scene.spec(), Some(settings.model))?;
+            let spec = cli.scene.spec();
+            let world = scene::build_world_for(&spec, Some(settings.model))?;
             // The app can switch to any model: plan for the hungriest.
             fits(world.spheres.len(), None)?;
-            ballpit::tui::run(world, settings, opts)
+            // A preset is made again for Reset rather than kept; a file's
+            // spheres are kept (the file may change meanwhile).
+            let from_file = spec.scene.as_deref().is_some_and(|s| {
+                std::path::Path::new(s).extension().is_some_and(|e| {
+                    e.eq_ignore_ascii_case("csv") || e.eq_ignore_ascii_case("toml")
+                })
+            });
+            let rebuild = (!from_file).then(|| {
+                let model = settings.model;
+                Box::new(move || Ok(scene::build_world_for(&spec, Some(model))?))
+                    as ballpit::engine::Rebuild
+            });
+            ballpit::tui::run_with_start(world, settings, opts, rebuild)
         }
     }
 }

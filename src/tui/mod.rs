@@ -24,7 +24,7 @@ pub mod theme;
 pub mod threads;
 pub mod writer;
 
-pub use run::run;
+pub use run::{run, run_with_start};
 pub use theme::ColorChoice;
 
 /// What the command line sets for the screen.

@@ -10,7 +10,7 @@ use super::theme::Palette;
 use super::writer::Output;
 use super::{Options, input, reader};
 use crate::cpu::{CpuReport, Sampler};
-use crate::engine::{Command, Engine, Settings, Snapshot};
+use crate::engine::{Command, Engine, Rebuild, Settings, Snapshot};
 use crate::error::BadInput;
 use crate::physics::World;
 use anyhow::{Context, anyhow};
@@ -27,6 +27,17 @@ const SAMPLE_PERIOD: Duration = Duration::from_secs(1);
 
 /// Open the screen on `world` and run until the user quits.
 pub fn run(world: World, settings: Settings, opts: Options) -> anyhow::Result<()> {
+    run_with_start(world, settings, opts, None)
+}
+
+/// As [`run`]; with `rebuild`, Reset makes the start again from the scene's
+/// description instead of the engine keeping a copy of the spheres.
+pub fn run_with_start(
+    world: World,
+    settings: Settings,
+    opts: Options,
+    rebuild: Option<Rebuild>,
+) -> anyhow::Result<()> {
     if !(opts.fps.is_finite() && opts.fps > 0.0 && opts.fps <= 1000.0) {
         return Err(BadInput(format!(
             "--fps must be greater than 0 and at most 1000, got {}",
@@ -54,9 +65,18 @@ pub fn run(world: World, settings: Settings, opts: Options) -> anyhow::Result<()
         world.spheres.iter().map(|s| s.radius).fold(0.0, f64::max),
         opts.fps,
     );
-    let engine = Engine::new(world, settings)?;
+    let engine = match rebuild {
+        Some(r) => Engine::with_rebuild(world, settings, r)?,
+        None => Engine::new(world, settings)?,
+    };
 
     let (tx, rx) = crossbeam_channel::unbounded();
+    // A frame slower than the frame period is collected when it is done,
+    // not at the next period's start.
+    let done = tx.clone();
+    engine.set_notify(Box::new(move || {
+        let _ = done.send(Msg::PhysicsDone);
+    }));
     let guard = Guard::enter(tx.clone()).context("cannot set up the terminal")?;
     let signals = guard::spawn_signals(tx.clone())?;
     reader::spawn_input(tx.clone())?;
@@ -107,6 +127,9 @@ struct FrameLoop {
     pending: bool,
     /// A frame was started and not finished; whether it applied commands.
     in_flight: Option<bool>,
+    /// A period began while the physics was still busy: its frame is drawn
+    /// as soon as the physics is done.
+    late: bool,
     /// Something on screen would change.
     dirty: bool,
     window: Window,
@@ -169,6 +192,7 @@ impl FrameLoop {
             sent_tick,
             pending: false,
             in_flight: None,
+            late: false,
             dirty: true,
             window: Window {
                 start: Some(Instant::now()),
@@ -220,6 +244,10 @@ impl FrameLoop {
                 let period = Duration::from_secs_f64(1.0 / self.state.fps);
                 next_frame = later(next_frame, period, now);
                 self.frame()?;
+            } else if self.late && self.engine.frame_ready() {
+                // In place of the frame the physics missed: never more
+                // frames than periods.
+                self.frame()?;
             } else {
                 self.present()?;
             }
@@ -248,6 +276,7 @@ impl FrameLoop {
                 self.pacer.written();
                 Ok(false)
             }
+            Msg::PhysicsDone => Ok(false),
             Msg::Resize => {
                 self.aspect = cell_aspect();
                 self.terminal.autoresize()?;
@@ -268,8 +297,10 @@ impl FrameLoop {
         if self.in_flight.is_some() && !self.engine.frame_ready() {
             // The physics is slower than the frame rate: keep drawing and
             // answering keys on the last snapshot rather than wait for it.
+            self.late = true;
             return self.present();
         }
+        self.late = false;
         if let Some(applied) = self.in_flight.take() {
             let snap = self.engine.finish_frame()?;
             self.window.steps += snap.steps;
