@@ -83,6 +83,17 @@ pub fn check(count: usize, model: Option<ModelKind>, free: Option<u64>) -> Resul
     ))
 }
 
+/// What `count` spheres would take and what the machine has, for a message
+/// that refuses them for another reason (e.g. more than ballpit supports).
+pub fn need_text(count: usize, model: Option<ModelKind>) -> String {
+    let with = model.map_or(String::new(), |m| format!(" with {m}"));
+    let have = available().map_or(String::new(), |f| format!("; {} is available", mib(f)));
+    format!(
+        "they would need about {} of memory{with}{have}",
+        mib(need(count, model))
+    )
+}
+
 fn mib(bytes: u64) -> String {
     if bytes >= 10 << 30 {
         format!("{} GiB", bytes >> 30)

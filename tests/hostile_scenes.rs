@@ -195,6 +195,15 @@ fn a_count_the_memory_cannot_hold_is_refused_with_the_figure() {
         err.starts_with("ballpit: 600000 spheres would need about 3") && err.contains("with exact"),
         "{err}"
     );
+    // Past the supported count, the message still says what it would take.
+    let (code, err) = bench(&["--count", "50000000", "--radius", "0.0001"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("more than the 10000000 spheres ballpit supports")
+            && err.contains("they would need about ")
+            && err.contains(" GiB of memory with swept"),
+        "{err}"
+    );
     let toml: String = "[[sphere]]\npos = [0.5, 0.5, 0.5]\nradius = 0.001\n".repeat(100_001);
     let e = toml_file::parse(&toml, "big.toml").unwrap_err();
     assert!(e.0.contains("100001 [[sphere]] entries"), "{e}");
