@@ -21,6 +21,11 @@ use std::collections::BinaryHeap;
 /// rescan; bigger ones (and the absorbing run) find members through the
 /// grid.
 const SMALL_RUN: usize = 32;
+/// A ball may grow to this many times its grid level's widest and still be
+/// found through the grid: wider searches cost more each, a narrower cap
+/// puts more balls on the run's own `grown` list (docs/benchmarks.md, "tuned
+/// constants").
+const GROWTH_CAP: f64 = 1.25;
 
 /// What every run of a step reads: the state at the start of the step and
 /// who has events.
@@ -325,7 +330,7 @@ impl Run {
         self.centre.push(centre);
         self.reach.push(reach);
         self.reach0.push(reach);
-        self.cap.push(sh.grid.growth_cap(reach));
+        self.cap.push(GROWTH_CAP * sh.grid.widest_in_level(reach));
         self.wall_momentum.push(0.0);
         self.wall_hits.push(0);
         self.pair_hits.push(0);
@@ -391,7 +396,7 @@ impl Run {
                         outsider(j, pj0, rj);
                     }
                 }
-                None => sh.grid.near_binned(q, rq, &mut outsider),
+                None => sh.grid.near(q, rq, 1.0, &mut outsider),
             }
             for l in 0..this.ids.len() {
                 let r = rq + this.reach[l];
@@ -410,7 +415,7 @@ impl Run {
                     found.push(j);
                 }
             };
-            sh.grid.near(q, rq, &mut consider);
+            sh.grid.near(q, rq, GROWTH_CAP, &mut consider);
             for &g in &this.grown {
                 let lg = g as usize;
                 consider(this.ids[lg], this.centre[lg], this.reach[lg]);
