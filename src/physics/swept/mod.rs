@@ -17,6 +17,9 @@
 //! scenes), a step is cut into equal parts, each run as above, so the
 //! pairs and clusters stay those of short paths (`parts.rs`).
 mod cluster;
+mod conflicts;
+mod group;
+mod partition;
 mod parts;
 mod rounds;
 
