@@ -1,9 +1,9 @@
 //! One cluster's contact events within a step, on private copies of its
 //! spheres: the serial event loop of `swept` (time order, lazy clocks,
 //! collision counters, rescans on every velocity change), run for a set of
-//! spheres that should not touch anyone outside it. An outsider with no
-//! events of its own that a member meets joins the run (the caller sees it
-//! if two runs took the same one in); a member of another cluster, whose
+//! spheres that should not touch anyone outside it. A bystander (a sphere
+//! with no events of its own) that a member meets joins the run (the caller
+//! sees it if it joined two runs); a member of another cluster, whose
 //! path is not known here, is only noted, and the caller checks the two
 //! paths once both runs are done (see `rounds`). Each member's path is kept
 //! as the turns it took.
@@ -90,7 +90,7 @@ impl Ord for Event {
 /// A turn in a member's path: from time `t` of the step it is at
 /// `pos + vel (t' - t)`, until its next turn.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Kink {
+pub(super) struct Turn {
     pub t: f64,
     pub pos: DVec3,
     pub vel: DVec3,
@@ -101,7 +101,7 @@ pub(super) struct Kink {
 pub(super) struct Member {
     pub id: u32,
     /// Its slot among the spheres with events when the run began (NONE for
-    /// one the run took in).
+    /// a bystander that joined the run).
     pub slot: u32,
     pub sphere: Sphere,
     /// Momentum given to the walls, for the pressure.
@@ -114,10 +114,10 @@ pub(super) struct Member {
     pub centre: DVec3,
     pub reach: f64,
     pub grew: bool,
-    /// Its turns: `kinks` of them from `kink0` on, in time order, in the
-    /// run's [`Run::kinks`] (then wherever the caller copies them).
-    pub kink0: u32,
-    pub kinks: u32,
+    /// Its turns: `turns` of them from `turn0` on, in time order, in the
+    /// run's [`Run::turns`] (then wherever the caller copies them).
+    pub turn0: u32,
+    pub turns: u32,
 }
 
 /// Scratch for one run, kept to reuse memory.
@@ -144,9 +144,9 @@ pub(super) struct Run {
     found: Vec<u32>,
     /// Turns, by local index, in the order they happened; sorted by member
     /// when the run ends.
-    turns: Vec<(u32, Kink)>,
-    kinks: Vec<Kink>,
-    kink_at: Vec<(u32, u32)>,
+    turn_log: Vec<(u32, Turn)>,
+    turns: Vec<Turn>,
+    turn_at: Vec<(u32, u32)>,
     /// (member, member of another cluster) whose balls met: the caller
     /// compares their paths when both runs are done.
     pub cross: Vec<(u32, u32)>,
@@ -234,26 +234,26 @@ impl Run {
             self.wall_hits[l] += hits as u32;
         }
         // Each member's turns together, still in time order (stable sort).
-        self.turns.sort_by_key(|&(l, _)| l);
-        self.kinks.clear();
-        self.kink_at.clear();
-        self.kink_at.resize(self.ids.len(), (0, 0));
-        for &(l, k) in &self.turns {
-            let at = &mut self.kink_at[l as usize];
+        self.turn_log.sort_by_key(|&(l, _)| l);
+        self.turns.clear();
+        self.turn_at.clear();
+        self.turn_at.resize(self.ids.len(), (0, 0));
+        for &(l, k) in &self.turn_log {
+            let at = &mut self.turn_at[l as usize];
             if at.1 == 0 {
-                at.0 = self.kinks.len() as u32;
+                at.0 = self.turns.len() as u32;
             }
             at.1 += 1;
-            self.kinks.push(k);
+            self.turns.push(k);
         }
     }
 
     /// Member `l` changed velocity at `t` (it is there now).
     fn turn(&mut self, l: usize, t: f64) {
         let s = &self.sp[l];
-        self.turns.push((
+        self.turn_log.push((
             l as u32,
-            Kink {
+            Turn {
                 t,
                 pos: s.pos,
                 vel: s.vel,
@@ -261,9 +261,9 @@ impl Run {
         ));
     }
 
-    /// The turns of the last finished run's members (see [`Member::kink0`]).
-    pub fn kinks(&self) -> &[Kink] {
-        &self.kinks
+    /// The turns of the last finished run's members (see [`Member::turn0`]).
+    pub fn turns(&self) -> &[Turn] {
+        &self.turns
     }
 
     /// The members of the last finished run.
@@ -278,8 +278,8 @@ impl Run {
             centre: self.centre[l],
             reach: self.reach[l],
             grew: self.reach[l] > self.reach0[l],
-            kink0: self.kink_at[l].0,
-            kinks: self.kink_at[l].1,
+            turn0: self.turn_at[l].0,
+            turns: self.turn_at[l].1,
         })
     }
 
@@ -301,7 +301,7 @@ impl Run {
         self.wall_hits.clear();
         self.pair_hits.clear();
         self.heap.clear();
-        self.turns.clear();
+        self.turn_log.clear();
         self.capped = false;
         self.cross.clear();
     }
@@ -376,8 +376,8 @@ impl Run {
         let this = &*self;
         if !absorb && self.ids.len() <= SMALL_RUN {
             // Members are few: they are checked one by one with their grown
-            // balls, so the grid is searched only for outsiders.
-            let mut outsider = |j: u32, pj0: DVec3, rj: f64| {
+            // balls, so the grid is searched only for non-members.
+            let mut non_member = |j: u32, pj0: DVec3, rj: f64| {
                 // The distance first: it reads what the grid handed over,
                 // the member table is a read elsewhere in memory.
                 if q.distance_squared(pj0) <= (rq + rj) * (rq + rj) && this.member(j).is_none() {
@@ -386,17 +386,17 @@ impl Run {
             };
             // When the ball around the rest of the path lies inside the
             // sphere's binned ball (well inside: far above rounding), every
-            // outsider it can meet is one of the pairs the grid already
+            // non-member it can meet is one of the pairs the grid already
             // found for it, and the same test picks the same ones.
             let inside = (q - this.centre[la]).length() + rq <= this.reach0[la] * (1.0 - 1e-9);
             match sh.partners_of(this.slots[la]).filter(|_| inside) {
                 Some(partners) => {
                     for &j in partners {
                         let (pj0, rj) = path_ball(&sh.spheres[j as usize], sh.dt);
-                        outsider(j, pj0, rj);
+                        non_member(j, pj0, rj);
                     }
                 }
-                None => sh.grid.near(q, rq, 1.0, &mut outsider),
+                None => sh.grid.near(q, rq, 1.0, &mut non_member),
             }
             for l in 0..this.ids.len() {
                 let r = rq + this.reach[l];
@@ -405,7 +405,7 @@ impl Run {
                 }
             }
         } else {
-            // Outsiders are judged by the ball the grid holds for them: a
+            // Non-members are judged by the ball the grid holds for them: a
             // run never reads another run's state. A member grown past its
             // cap is no longer found through the grid, so `grown` is
             // checked by hand.
@@ -456,8 +456,8 @@ impl Run {
             if t + dtc > sh.dt {
                 continue;
             }
-            // A sphere with no events that a member meets joins the run;
-            // if another run took it in too, the caller sees it taken twice.
+            // A bystander that a member meets joins the run; if it joined
+            // another run too, the caller sees it joined twice.
             let lb = match l {
                 Some(l) => l as u32,
                 None => self.involve(sh, j),

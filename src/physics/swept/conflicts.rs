@@ -3,7 +3,7 @@
 //! (noted by a run, or grown balls found by a grid over all of them) are
 //! compared turn by turn, and those that come within touching distance are
 //! conflicts: their clusters merge and run again.
-use super::cluster::{Kink, Member};
+use super::cluster::{Member, Turn};
 use super::partition::Partition;
 use super::path_ball;
 use super::rounds::RoundStats;
@@ -25,8 +25,8 @@ pub(super) struct Finished {
     pub capped: Vec<bool>,
     /// The round that run was made in (NONE before any).
     pub ran: Vec<u32>,
-    /// Every finished member's turns (`Member::kink0` indexes here).
-    pub turns: Vec<Kink>,
+    /// Every finished member's turns (`Member::turn0` indexes here).
+    pub turns: Vec<Turn>,
 }
 
 impl Finished {
@@ -56,7 +56,7 @@ impl Finished {
         }
         let path = |s: usize| {
             let m = self.out[s].expect("a finished run's member");
-            let turns = &self.turns[m.kink0 as usize..(m.kink0 + m.kinks) as usize];
+            let turns = &self.turns[m.turn0 as usize..(m.turn0 + m.turns) as usize];
             (&spheres[m.id as usize], turns)
         };
         let ((sa, ta), (sb, tb)) = (path(a), path(b));
@@ -117,7 +117,7 @@ impl Conflicts {
 
     /// A finished cluster whose member's ball grew was checked against the
     /// balls the grid holds, of spheres that had events then. Two such
-    /// grown balls, or any ball and that of a sphere a run took in (which
+    /// grown balls, or any ball and that of a bystander that joined a run (which
     /// other runs took to fly straight), may meet where no run could see
     /// it: such pairs in different clusters are compared by their paths.
     #[allow(clippy::too_many_arguments)]
@@ -200,9 +200,9 @@ const PATH_MARGIN: f64 = 1e-8;
 /// turning as `ta` and `tb` say (time order), come within the sum of their
 /// radii (widened by [`PATH_MARGIN`]) at one moment of `0..=dt`: on each
 /// stretch where both fly straight, the closest approach of the two lines.
-fn paths_meet(a: &Sphere, ta: &[Kink], b: &Sphere, tb: &[Kink], dt: f64) -> bool {
+fn paths_meet(a: &Sphere, ta: &[Turn], b: &Sphere, tb: &[Turn], dt: f64) -> bool {
     let sigma = (a.radius + b.radius) * (1.0 + PATH_MARGIN);
-    let start = |s: &Sphere| Kink {
+    let start = |s: &Sphere| Turn {
         t: 0.0,
         pos: s.pos,
         vel: s.vel,
@@ -211,7 +211,7 @@ fn paths_meet(a: &Sphere, ta: &[Kink], b: &Sphere, tb: &[Kink], dt: f64) -> bool
     let (mut ia, mut ib) = (0, 0);
     let mut t0 = 0.0;
     loop {
-        let next = |turns: &[Kink], i: usize| turns.get(i).map_or(dt, |k| k.t.min(dt));
+        let next = |turns: &[Turn], i: usize| turns.get(i).map_or(dt, |k| k.t.min(dt));
         let t1 = next(ta, ia).min(next(tb, ib));
         let dp = (ka.pos + ka.vel * (t0 - ka.t)) - (kb.pos + kb.vel * (t0 - kb.t));
         let dv = ka.vel - kb.vel;
@@ -252,8 +252,8 @@ mod tests {
         }
     }
 
-    fn turn(t: f64, pos: [f64; 3], vel: [f64; 3]) -> Kink {
-        Kink {
+    fn turn(t: f64, pos: [f64; 3], vel: [f64; 3]) -> Turn {
+        Turn {
             t,
             pos: DVec3::from(pos),
             vel: DVec3::from(vel),

@@ -166,7 +166,8 @@ impl Partition {
         self.dirty[root as usize] = false;
     }
 
-    /// A slot for sphere `id`, taken in after the first round, on its own.
+    /// A slot for sphere `id`, a bystander met after the first round, on
+    /// its own.
     pub fn add(&mut self, id: u32) -> u32 {
         let k = self.ids.len() as u32;
         self.slot[id as usize] = k;
@@ -179,8 +180,8 @@ impl Partition {
     }
 
     /// Every cluster, finished or not, as one: the plain serial loop over
-    /// all the spheres with events, which no bystander with events can
-    /// touch, so it finishes in one run. No rescan of it looks up partners
+    /// all the spheres with events, which no sphere outside it with
+    /// events can touch, so it finishes in one run. No rescan of it looks up partners
     /// (the one run searches the grid).
     pub fn merge_all(&mut self) {
         let m = self.ids.len();

@@ -9,9 +9,9 @@
 //! noted. Once every run of a round is done, the paths decide, turn by turn,
 //! whether such pairs really come within touching distance (with a margin
 //! far above rounding), and so do all balls that meet where one sphere's
-//! path turned or was taken in by a run (the others took it to fly
-//! straight). Those that do conflict, as do two runs that took in the same
-//! sphere: conflicting clusters are merged and run again, until a round
+//! path turned or that is a bystander that joined a run (the others took it
+//! to fly straight). Those that do conflict, as do two runs that a bystander
+//! joined: conflicting clusters are merged and run again, until a round
 //! ends with no conflict. When rounds go on too long, or merging leaves
 //! most spheres to run again, or over 30 % of the spheres have events from
 //! the start (clusters percolate), everything runs as one cluster: the
@@ -53,8 +53,8 @@ struct BlockOut {
     /// Finished clusters: (capped, how many of `members` are theirs).
     done: Vec<(bool, u32)>,
     members: Vec<Member>,
-    /// The members' turns (`Member::kink0` indexes here).
-    kinks: Vec<super::cluster::Kink>,
+    /// The members' turns (`Member::turn0` indexes here).
+    turns: Vec<super::cluster::Turn>,
     /// Finished runs' (member, member of another cluster) to compare.
     cross: Vec<(u32, u32)>,
 }
@@ -212,7 +212,7 @@ impl Rounds {
     }
 
     /// The slots in sphere order: the first round's already are; the ones
-    /// runs took in later are merged in.
+    /// that joined runs later are merged in.
     fn order_results(&mut self) {
         let (m, first) = (self.part.ids.len(), self.part.first_late);
         self.in_order.clear();
@@ -252,8 +252,8 @@ impl Rounds {
         false
     }
 
-    /// A slot for sphere `id`, taken in by a run or met by one after the
-    /// first round.
+    /// A slot for sphere `id`, a bystander that joined a run or that one
+    /// met after the first round.
     fn add_slot(&mut self, id: u32) -> u32 {
         self.fin.push();
         self.part.add(id)
@@ -285,7 +285,7 @@ impl Rounds {
                 let mut out = outs[b].lock();
                 out.done.clear();
                 out.members.clear();
-                out.kinks.clear();
+                out.turns.clear();
                 out.cross.clear();
                 let end = ((b + 1) * CLUSTER_BLOCK).min(todo.len());
                 for t in &todo[b * CLUSTER_BLOCK..end] {
@@ -293,10 +293,10 @@ impl Rounds {
                     let cp = &pairs[t.p0 as usize..t.p1 as usize];
                     run.run(sh, members, cp, absorb);
                     let before = out.members.len();
-                    let base = out.kinks.len() as u32;
-                    out.kinks.extend_from_slice(run.kinks());
+                    let base = out.turns.len() as u32;
+                    out.turns.extend_from_slice(run.turns());
                     out.members.extend(run.members().map(|mut m| {
-                        m.kink0 += base;
+                        m.turn0 += base;
                         m
                     }));
                     out.cross.extend_from_slice(&run.cross);
@@ -312,7 +312,7 @@ impl Rounds {
     fn collect(&mut self) {
         self.conf.found.clear();
         let round = self.stats.rounds as u32;
-        // Slots from here on are spheres runs took in this round.
+        // Slots from here on are bystanders that joined runs this round.
         let known = self.part.ids.len();
         let mut cross = std::mem::take(&mut self.conf.cross);
         let fresh = cross.len();
@@ -323,12 +323,12 @@ impl Rounds {
             for &(capped, len) in &out.done {
                 let members = &out.members[k..k + len as usize];
                 k += len as usize;
-                // Spheres a run took in are its members now.
+                // Bystanders that joined a run are its members now.
                 let mut root = NONE;
                 let mut twice = false;
                 for m in members {
-                    // The run read the slot when it began; one it took in
-                    // may have got one from an earlier run of this round.
+                    // The run read the slot when it began; a bystander that
+                    // joined may have got one from an earlier run of this round.
                     let s = match m.slot {
                         NONE => match self.part.slot[m.id as usize] {
                             NONE => self.add_slot(m.id),
@@ -336,13 +336,13 @@ impl Rounds {
                         },
                         s => s,
                     };
-                    // Taken in by an earlier run of this round too: the two
+                    // Joined an earlier run of this round too: the two
                     // runs join (below) and run again.
                     twice |= s as usize >= known && self.fin.ran[s as usize] == round;
-                    let turns = &out.kinks[m.kink0 as usize..(m.kink0 + m.kinks) as usize];
-                    let kink0 = self.fin.turns.len() as u32;
+                    let turns = &out.turns[m.turn0 as usize..(m.turn0 + m.turns) as usize];
+                    let turn0 = self.fin.turns.len() as u32;
                     self.fin.turns.extend_from_slice(turns);
-                    self.fin.out[s as usize] = Some(Member { kink0, ..*m });
+                    self.fin.out[s as usize] = Some(Member { turn0, ..*m });
                     self.fin.capped[s as usize] = capped;
                     self.fin.ran[s as usize] = round;
                     root = if root == NONE {
