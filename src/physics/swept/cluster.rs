@@ -12,7 +12,6 @@ use crate::physics::broad::Grid;
 use crate::physics::contact::{pair_toi, reflect_walls, resolve_pair, wall_toi};
 use crate::physics::flight::fly;
 use crate::physics::sphere::Sphere;
-use crate::physics::swept::pair_mut;
 use glam::DVec3;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -203,7 +202,10 @@ impl Run {
             } else {
                 self.advance_to(lb, e.t);
                 self.count[lb] += 1;
-                let (x, y) = pair_mut(&mut self.sp, la, lb);
+                // Two members: a pair event never names one sphere twice.
+                let Ok([x, y]) = self.sp.get_disjoint_mut([la, lb]) else {
+                    unreachable!("a pair event of one sphere");
+                };
                 if resolve_pair(x, y) {
                     self.pair_hits[la.min(lb)] += 1;
                 }
