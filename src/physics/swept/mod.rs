@@ -32,6 +32,7 @@ use super::sphere::Sphere;
 use super::world::World;
 use glam::DVec3;
 use parking_lot::Mutex;
+pub use parts::ADDED_PAIRS;
 pub use rounds::RoundStats;
 use rounds::Rounds;
 
