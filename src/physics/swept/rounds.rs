@@ -3,8 +3,8 @@
 //! The spheres with an event (a pair that meets, or a wall) are grouped:
 //! pairs that meet, and pairs of such spheres whose balls for the step
 //! overlap, end up in one cluster. Each cluster runs the serial event loop
-//! on its own (`cluster::Run`), on any lane; a sphere with no events that a
-//! run meets joins that run. Spheres of two clusters whose balls met after
+//! on its own (`cluster::Run`), on any lane; a bystander (a sphere with no
+//! events) that a run meets joins that run. Spheres of two clusters whose balls met after
 //! all (a member's ball grew into the other's as its path turned) are only
 //! noted. Once every run of a round is done, the paths decide, turn by turn,
 //! whether such pairs really come within touching distance (with a margin
