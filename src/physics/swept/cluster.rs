@@ -7,6 +7,7 @@
 //! path is not known here, is only noted, and the caller checks the two
 //! paths once both runs are done (see `rounds`). Each member's path is kept
 //! as the turns it took.
+use super::partition::Slot;
 use super::{NONE, REACH_SLACK, path_ball};
 use crate::physics::broad::Grid;
 use crate::physics::contact::{pair_toi, reflect_walls, resolve_pair, wall_toi};
@@ -31,8 +32,8 @@ const GROWTH_CAP: f64 = 1.25;
 pub(super) struct Shared<'a> {
     pub spheres: &'a [Sphere],
     pub grid: &'a Grid,
-    /// Sphere id → its slot among the involved spheres, or NONE.
-    pub slot: &'a [u32],
+    /// Sphere id → its slot among the involved spheres, or `Slot::NONE`.
+    pub slot: &'a [Slot],
     /// By slot of the first round: where its partners among the step's
     /// pairs start in `partners` (see [`Shared::partners_of`]).
     pub partner_start: &'a [u32],
@@ -44,8 +45,8 @@ pub(super) struct Shared<'a> {
 impl Shared<'_> {
     /// Every sphere whose binned ball meets the binned ball of the sphere
     /// in `slot`, if that slot was indexed.
-    fn partners_of(&self, slot: u32) -> Option<&[u32]> {
-        let s = slot as usize;
+    fn partners_of(&self, slot: Slot) -> Option<&[u32]> {
+        let s = slot.index();
         let end = *self.partner_start.get(s.checked_add(1)?)?;
         Some(&self.partners[self.partner_start[s] as usize..end as usize])
     }
@@ -99,9 +100,9 @@ pub(super) struct Turn {
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Member {
     pub id: u32,
-    /// Its slot among the spheres with events when the run began (NONE for
+    /// Its slot among the spheres with events when the run began (`Slot::NONE` for
     /// a bystander that joined the run).
-    pub slot: u32,
+    pub slot: Slot,
     pub sphere: Sphere,
     /// Momentum given to the walls, for the pressure.
     pub wall_momentum: f64,
@@ -123,7 +124,7 @@ pub(super) struct Member {
 #[derive(Default)]
 pub(super) struct Run {
     ids: Vec<u32>,
-    slots: Vec<u32>,
+    slots: Vec<Slot>,
     /// Sphere id → local index for members, NONE for everyone else; kept
     /// so between runs (one lookup per candidate, the hot path).
     local_of: Vec<u32>,
@@ -430,7 +431,7 @@ impl Run {
                 continue;
             }
             let l = self.member(j);
-            if l.is_none() && sh.slot[j as usize] != NONE {
+            if l.is_none() && !sh.slot[j as usize].is_none() {
                 // A member of another cluster whose ball meets ours: its path
                 // is not known here, so the caller compares the paths.
                 self.cross.push((ia, j));

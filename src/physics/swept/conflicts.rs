@@ -4,7 +4,7 @@
 //! compared turn by turn, and those that come within touching distance are
 //! conflicts: their clusters merge and run again.
 use super::cluster::{Member, Turn};
-use super::partition::Partition;
+use super::partition::{Partition, Slot};
 use super::path_ball;
 use super::rounds::RoundStats;
 use crate::physics::broad::Grid;
@@ -86,7 +86,7 @@ pub(super) struct Conflicts {
     balls: Vec<Sphere>,
     overlap: Grid,
     overlap_pairs: Vec<(u32, u32)>,
-    cluster_of: Vec<u32>,
+    cluster_of: Vec<Slot>,
 }
 
 impl Conflicts {
@@ -106,9 +106,9 @@ impl Conflicts {
                 continue;
             }
             stats.compared += 1;
-            if fin.meet(sa as usize, sb as usize, spheres, dt) {
+            if fin.meet(sa.index(), sb.index(), spheres, dt) {
                 self.found
-                    .push((part.ids[sa as usize], part.ids[sb as usize]));
+                    .push((part.ids[sa.index()], part.ids[sb.index()]));
             } else {
                 stats.apart += 1;
             }
@@ -148,10 +148,9 @@ impl Conflicts {
             });
         }
         // Merges since the round began joined clusters: name them afresh.
-        self.cluster_of.resize(m, super::NONE);
-        for s in 0..m as u32 {
-            self.cluster_of[s as usize] = part.find(s);
-        }
+        self.cluster_of.clear();
+        self.cluster_of
+            .extend((0..m).map(|s| part.find(Slot::at(s))));
         self.overlap.build(
             &self.balls,
             size,

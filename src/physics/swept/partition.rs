@@ -3,8 +3,29 @@
 //! form a cycle, so a merged cluster's members are found without scanning
 //! everyone), and each round's clusters to run are laid out with their
 //! members and meeting pairs.
-use super::NONE;
 use super::group::group;
+
+/// A sphere's place among the spheres with events of a step part: what
+/// everything kept by slot is indexed with, never a sphere id.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub(super) struct Slot(u32);
+
+impl Slot {
+    /// No slot: the sphere has no events (yet).
+    pub const NONE: Slot = Slot(u32::MAX);
+
+    pub fn at(index: usize) -> Slot {
+        Slot(index as u32)
+    }
+
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+
+    pub fn is_none(self) -> bool {
+        self == Slot::NONE
+    }
+}
 
 /// A cluster to run: members `order[m0..m1]`, meeting pairs
 /// `pairs[p0..p1]`.
@@ -31,19 +52,19 @@ pub(super) struct Batch {
 /// The spheres with events of one step part, and their clusters.
 #[derive(Default)]
 pub(super) struct Partition {
-    /// Sphere id → slot among the involved, NONE for the rest.
-    pub slot: Vec<u32>,
+    /// Sphere id → slot among the involved, `Slot::NONE` for the rest.
+    pub slot: Vec<Slot>,
     /// Slot → sphere id.
     pub ids: Vec<u32>,
     /// Slots from here on were added after the first round.
     pub first_late: usize,
-    parent: Vec<u32>,
+    parent: Vec<Slot>,
     /// Each cluster's slots as a cycle (`next` of the last is the first).
-    next: Vec<u32>,
+    next: Vec<Slot>,
     /// By root slot: the cluster must run (again).
     dirty: Vec<bool>,
     /// Roots marked dirty since the last partition (some merged since).
-    dirty_roots: Vec<u32>,
+    dirty_roots: Vec<Slot>,
     /// Set by `merge_all`: the next partition is one cluster of everyone.
     whole: bool,
     /// By slot: where its meeting pairs (as the pair's first sphere) start
@@ -51,7 +72,7 @@ pub(super) struct Partition {
     meet_start: Vec<u32>,
     meets_of: Vec<u32>,
     /// By meeting pair: the slot of its first sphere.
-    meet_slot: Vec<u32>,
+    meet_slot: Vec<Slot>,
     /// By slot of the first round: where its partners among the step's
     /// pairs (meeting or near) start in `partners`.
     pub partner_start: Vec<u32>,
@@ -63,22 +84,22 @@ impl Partition {
     /// wall, in sphere order, each its own cluster; returns how many.
     pub fn start(&mut self, n: usize, meets: &[(u32, u32)], hits: &[u32]) -> usize {
         for &i in &self.ids {
-            self.slot[i as usize] = NONE;
+            self.slot[i as usize] = Slot::NONE;
         }
-        self.slot.resize(n, NONE);
+        self.slot.resize(n, Slot::NONE);
         self.ids.clear();
         // Marked, then read off in order: one pass over the spheres costs
         // less than sorting the tens of thousands of ends of the pairs.
         for &(i, j) in meets {
-            self.slot[i as usize] = 0;
-            self.slot[j as usize] = 0;
+            self.slot[i as usize] = Slot(0);
+            self.slot[j as usize] = Slot(0);
         }
         for &i in hits {
-            self.slot[i as usize] = 0;
+            self.slot[i as usize] = Slot(0);
         }
         for (i, slot) in self.slot.iter_mut().enumerate() {
-            if *slot != NONE {
-                *slot = self.ids.len() as u32;
+            if !slot.is_none() {
+                *slot = Slot::at(self.ids.len());
                 self.ids.push(i as u32);
             }
         }
@@ -88,9 +109,9 @@ impl Partition {
         let m = self.ids.len();
         self.first_late = m;
         self.parent.clear();
-        self.parent.extend(0..m as u32);
+        self.parent.extend((0..m).map(Slot::at));
         self.next.clear();
-        self.next.extend(0..m as u32);
+        self.next.extend((0..m).map(Slot::at));
         self.dirty_roots.clear();
         self.dirty.clear();
         self.dirty.resize(m, true);
@@ -105,7 +126,7 @@ impl Partition {
         }
         for &(i, j) in near {
             let (a, b) = (self.slot[i as usize], self.slot[j as usize]);
-            if a != NONE && b != NONE {
+            if !a.is_none() && !b.is_none() {
                 self.union(a, b);
             }
         }
@@ -123,7 +144,7 @@ impl Partition {
             .flat_map(|&(i, j)| [(i, j), (j, i)]);
         let by_slot = ends.filter_map(|(k, other)| {
             let a = slot[k as usize];
-            (a != NONE).then_some((a, other))
+            (!a.is_none()).then_some((a.0, other))
         });
         group(
             &mut self.partner_start,
@@ -133,43 +154,43 @@ impl Partition {
         );
     }
 
-    pub fn find(&mut self, mut x: u32) -> u32 {
-        while self.parent[x as usize] != x {
-            let p = self.parent[x as usize];
-            self.parent[x as usize] = self.parent[p as usize];
+    pub fn find(&mut self, mut x: Slot) -> Slot {
+        while self.parent[x.index()] != x {
+            let p = self.parent[x.index()];
+            self.parent[x.index()] = self.parent[p.index()];
             x = p;
         }
         x
     }
 
     /// Joins two slots' clusters; the joined cluster must run again.
-    pub fn union(&mut self, a: u32, b: u32) {
+    pub fn union(&mut self, a: Slot, b: Slot) {
         let lo = self.link(a, b);
-        self.dirty[lo as usize] = true;
+        self.dirty[lo.index()] = true;
         self.dirty_roots.push(lo);
     }
 
     /// Joins two slots' clusters under the lower root, which it returns.
-    pub fn link(&mut self, a: u32, b: u32) -> u32 {
+    pub fn link(&mut self, a: Slot, b: Slot) -> Slot {
         let (ra, rb) = (self.find(a), self.find(b));
         let (lo, hi) = (ra.min(rb), ra.max(rb));
         if lo != hi {
-            self.parent[hi as usize] = lo;
+            self.parent[hi.index()] = lo;
             // Splicing two cycles is swapping one successor of each.
-            self.next.swap(lo as usize, hi as usize);
+            self.next.swap(lo.index(), hi.index());
         }
         lo
     }
 
     /// Cluster `root` ran and needs no rerun unless it merges.
-    pub fn ran(&mut self, root: u32) {
-        self.dirty[root as usize] = false;
+    pub fn ran(&mut self, root: Slot) {
+        self.dirty[root.index()] = false;
     }
 
     /// A slot for sphere `id`, a bystander met after the first round, on
     /// its own.
-    pub fn add(&mut self, id: u32) -> u32 {
-        let k = self.ids.len() as u32;
+    pub fn add(&mut self, id: u32) -> Slot {
+        let k = Slot::at(self.ids.len());
         self.slot[id as usize] = k;
         self.ids.push(id);
         self.parent.push(k);
@@ -186,12 +207,12 @@ impl Partition {
     pub fn merge_all(&mut self) {
         let m = self.ids.len();
         for s in 0..m {
-            self.parent[s] = 0;
-            self.next[s] = ((s + 1) % m) as u32;
+            self.parent[s] = Slot(0);
+            self.next[s] = Slot::at((s + 1) % m);
         }
         if m > 0 {
             self.dirty[0] = true;
-            self.dirty_roots.push(0);
+            self.dirty_roots.push(Slot(0));
         }
         self.whole = true;
     }
@@ -245,8 +266,8 @@ impl Partition {
         self.index_meets(meets);
         // Every cluster, by root (a root is its own parent), walked round
         // its cycle.
-        for root in 0..self.ids.len() as u32 {
-            if self.parent[root as usize] == root {
+        for root in (0..self.ids.len()).map(Slot::at) {
+            if self.parent[root.index()] == root {
                 self.push_cluster(root, meets, batch);
             }
         }
@@ -255,7 +276,7 @@ impl Partition {
     /// Each first-round slot's meeting pairs (as the pair's first sphere).
     fn index_meets(&mut self, meets: &[(u32, u32)]) {
         debug_assert_eq!(self.meet_slot.len(), meets.len());
-        let by_slot = self.meet_slot.iter().copied().zip(0..);
+        let by_slot = self.meet_slot.iter().map(|s| s.0).zip(0..);
         group(
             &mut self.meet_start,
             &mut self.meets_of,
@@ -266,26 +287,24 @@ impl Partition {
 
     /// Cluster `root` as a run to make: its members in sphere order and its
     /// meeting pairs in detection order (the order the first round has).
-    fn push_cluster(&self, root: u32, meets: &[(u32, u32)], batch: &mut Batch) {
+    fn push_cluster(&self, root: Slot, meets: &[(u32, u32)], batch: &mut Batch) {
         let (found, ps) = (&mut batch.found, &mut batch.ps);
         found.clear();
         ps.clear();
         let mut s = root;
         loop {
-            found.push(s);
+            // Slots of the first round are in sphere order; later ones are
+            // not: the ids are sorted below.
+            found.push(self.ids[s.index()]);
             // Slots added after the first round own no meeting pairs.
-            if (s as usize) < self.first_late {
-                let (a, b) = (self.meet_start[s as usize], self.meet_start[s as usize + 1]);
+            if s.index() < self.first_late {
+                let (a, b) = (self.meet_start[s.index()], self.meet_start[s.index() + 1]);
                 ps.extend_from_slice(&self.meets_of[a as usize..b as usize]);
             }
-            s = self.next[s as usize];
+            s = self.next[s.index()];
             if s == root {
                 break;
             }
-        }
-        // Slots of the first round are in sphere order; later ones are not.
-        for s in found.iter_mut() {
-            *s = self.ids[*s as usize];
         }
         found.sort_unstable();
         ps.sort_unstable();
@@ -310,7 +329,7 @@ impl Partition {
         }
         roots.sort_unstable();
         roots.dedup();
-        roots.retain(|&r| self.dirty[r as usize]);
+        roots.retain(|&r| self.dirty[r.index()]);
         for &root in &roots {
             self.push_cluster(root, meets, batch);
         }

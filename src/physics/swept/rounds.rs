@@ -26,10 +26,9 @@
 //!
 //! Here: the rounds and the runs of each. The clusters themselves are in
 //! `partition.rs`, the path comparison and grown balls in `conflicts.rs`.
-use super::NONE;
 use super::cluster::{Member, Run, Shared};
 use super::conflicts::{Conflicts, Finished};
-use super::partition::{Batch, Partition};
+use super::partition::{Batch, Partition, Slot};
 use crate::physics::broad::Grid;
 use crate::physics::exec::{Exec, Serial, next_blocks};
 use crate::physics::sphere::Sphere;
@@ -105,8 +104,8 @@ pub(super) struct Rounds {
     outs: Vec<Mutex<BlockOut>>,
     /// The slots in sphere order, for [`Rounds::results`], and scratch for
     /// the late ones.
-    in_order: Vec<u32>,
-    late: Vec<u32>,
+    in_order: Vec<Slot>,
+    late: Vec<Slot>,
     pub stats: RoundStats,
     /// Run every step as one absorbing cluster (the plain serial loop),
     /// whatever the lanes.
@@ -120,7 +119,7 @@ impl Rounds {
     /// to the bit, however the clusters fell).
     pub fn results(&self) -> impl Iterator<Item = (&Member, bool)> {
         self.in_order.iter().map(|&s| {
-            let s = s as usize;
+            let s = s.index();
             let m = self.fin.out[s].as_ref();
             (
                 m.expect("every involved sphere finished"),
@@ -219,11 +218,11 @@ impl Rounds {
         let ids = &self.part.ids;
         let mut late = std::mem::take(&mut self.late);
         late.clear();
-        late.extend(first as u32..m as u32);
-        late.sort_unstable_by_key(|&s| ids[s as usize]);
-        let mut early = (0..first as u32).peekable();
+        late.extend((first..m).map(Slot::at));
+        late.sort_unstable_by_key(|&s| ids[s.index()]);
+        let mut early = (0..first).map(Slot::at).peekable();
         for &l in &late {
-            while let Some(e) = early.next_if(|&e| ids[e as usize] < ids[l as usize]) {
+            while let Some(e) = early.next_if(|&e| ids[e.index()] < ids[l.index()]) {
                 self.in_order.push(e);
             }
             self.in_order.push(l);
@@ -254,7 +253,7 @@ impl Rounds {
 
     /// A slot for sphere `id`, a bystander that joined a run or that one
     /// met after the first round.
-    fn add_slot(&mut self, id: u32) -> u32 {
+    fn add_slot(&mut self, id: u32) -> Slot {
         self.fin.push();
         self.part.add(id)
     }
@@ -324,28 +323,25 @@ impl Rounds {
                 let members = &out.members[k..k + len as usize];
                 k += len as usize;
                 // Bystanders that joined a run are its members now.
-                let mut root = NONE;
+                let mut root = Slot::NONE;
                 let mut twice = false;
                 for m in members {
                     // The run read the slot when it began; a bystander that
                     // joined may have got one from an earlier run of this round.
-                    let s = match m.slot {
-                        NONE => match self.part.slot[m.id as usize] {
-                            NONE => self.add_slot(m.id),
-                            s => s,
-                        },
-                        s => s,
+                    let s = match (m.slot, self.part.slot[m.id as usize]) {
+                        (Slot::NONE, Slot::NONE) => self.add_slot(m.id),
+                        (Slot::NONE, s) | (s, _) => s,
                     };
                     // Joined an earlier run of this round too: the two
                     // runs join (below) and run again.
-                    twice |= s as usize >= known && self.fin.ran[s as usize] == round;
+                    twice |= s.index() >= known && self.fin.ran[s.index()] == round;
                     let turns = &out.turns[m.turn0 as usize..(m.turn0 + m.turns) as usize];
                     let turn0 = self.fin.turns.len() as u32;
                     self.fin.turns.extend_from_slice(turns);
-                    self.fin.out[s as usize] = Some(Member { turn0, ..*m });
-                    self.fin.capped[s as usize] = capped;
-                    self.fin.ran[s as usize] = round;
-                    root = if root == NONE {
+                    self.fin.out[s.index()] = Some(Member { turn0, ..*m });
+                    self.fin.capped[s.index()] = capped;
+                    self.fin.ran[s.index()] = round;
+                    root = if root.is_none() {
                         self.part.find(s)
                     } else {
                         self.part.link(root, s)
@@ -367,7 +363,7 @@ impl Rounds {
         let mut k = 0;
         cross.retain(|&(a, _)| {
             k += 1;
-            k > fresh || ran[slot[a as usize] as usize] != round
+            k > fresh || ran[slot[a as usize].index()] != round
         });
         self.conf.cross = cross;
     }
@@ -376,7 +372,7 @@ impl Rounds {
         let conflicts = std::mem::take(&mut self.conf.found);
         for &(a, j) in &conflicts {
             let sj = match self.part.slot[j as usize] {
-                NONE => self.add_slot(j),
+                Slot::NONE => self.add_slot(j),
                 s => s,
             };
             self.part.union(self.part.slot[a as usize], sj);
