@@ -83,7 +83,7 @@ impl Exec for Lanes {
         self.0
     }
     fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
-        (0..self.0).rev().for_each(f)
+        (0..self.0).rev().for_each(f);
     }
     fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {
         b();

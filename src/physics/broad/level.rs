@@ -75,9 +75,9 @@ fn cell_coords(p: DVec3, inv_cell: f64, last: f64) -> [usize; 3] {
 /// chain, one add per eight cells instead of one per cell.
 fn running_sums(counts: &mut [u32], start: u32) -> u32 {
     let mut end = start;
-    let mut blocks = counts.chunks_exact_mut(8);
-    for block in &mut blocks {
-        let mut v: [u32; 8] = block.try_into().expect("eight");
+    let (blocks, rest) = counts.as_chunks_mut::<8>();
+    for block in blocks {
+        let mut v = *block;
         // Sums within the block by doubling shifts: vector adds, no chain.
         for shift in [1, 2, 4] {
             let prev = v;
@@ -90,7 +90,7 @@ fn running_sums(counts: &mut [u32], start: u32) -> u32 {
         }
         end += v[7];
     }
-    for c in blocks.into_remainder() {
+    for c in rest {
         end += *c;
         *c = end;
     }

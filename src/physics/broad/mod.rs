@@ -66,7 +66,7 @@ fn cell_of_sample(scratch: &mut [f64], max: f64) -> f64 {
         return 2.0 * max;
     }
     let k = (scratch.len() * 98 / 100).min(scratch.len() - 1);
-    let q = *scratch.select_nth_unstable_by(k, |a, b| a.total_cmp(b)).1;
+    let q = *scratch.select_nth_unstable_by(k, f64::total_cmp).1;
     // When the fastest is close to the bulk, one level holds everyone.
     2.0 * if max <= 1.25 * q { max } else { q }
 }
@@ -297,7 +297,7 @@ impl Grid {
         for level in &self.levels {
             level.near(p, reach + grow * level.reach_max, &mut |j| {
                 let e = &level.entries[j];
-                f(e.id, e.ball.pos, e.ball.reach)
+                f(e.id, e.ball.pos, e.ball.reach);
             });
         }
         for (b, id) in &self.top {
@@ -320,7 +320,7 @@ impl Grid {
                 // order; the caller's test, for the few that pass, does not.
                 let e = &level.entries[j];
                 if out(&e.ball) {
-                    f(e.id)
+                    f(e.id);
                 }
             });
         }
@@ -333,6 +333,7 @@ impl Grid {
 
     /// The widest ball of the level a ball of `reach` is binned in (infinite
     /// for the last few, which every search visits whatever their reach).
+    #[must_use]
     pub fn widest_in_level(&self, reach: f64) -> f64 {
         self.levels
             .iter()
@@ -342,6 +343,7 @@ impl Grid {
 
     /// Cells per side of each level, and how many spheres each holds (the
     /// last number: tested against everything). For diagnostics.
+    #[must_use]
     pub fn shape(&self) -> (Vec<(usize, usize)>, usize) {
         (
             self.levels

@@ -48,18 +48,17 @@ impl Finished {
     }
 
     /// Whether the spheres of slots `a` and `b` come within touching
-    /// distance during the step. A capped run's path is not fully known: it
-    /// meets everyone.
+    /// distance during the step. A path not fully known (a capped run's,
+    /// or one not run) meets everyone: a merge costs time, never a result.
     fn meet(&self, a: usize, b: usize, spheres: &[Sphere], dt: f64) -> bool {
-        if self.capped[a] || self.capped[b] {
-            return true;
-        }
         let path = |s: usize| {
-            let m = self.out[s].expect("a finished run's member");
+            let m = self.out[s].filter(|_| !self.capped[s])?;
             let turns = &self.turns[m.turn0 as usize..(m.turn0 + m.turns) as usize];
-            (&spheres[m.id as usize], turns)
+            Some((&spheres[m.id as usize], turns))
         };
-        let ((sa, ta), (sb, tb)) = (path(a), path(b));
+        let (Some((sa, ta)), Some((sb, tb))) = (path(a), path(b)) else {
+            return true;
+        };
         paths_meet(sa, ta, sb, tb, dt)
     }
 

@@ -335,9 +335,9 @@ impl Rounds {
                     // Joined an earlier run of this round too: the two
                     // runs join (below) and run again.
                     twice |= s.index() >= known && self.fin.ran[s.index()] == round;
-                    let turns = &out.turns[m.turn0 as usize..(m.turn0 + m.turns) as usize];
+                    let path = &out.turns[m.turn0 as usize..(m.turn0 + m.turns) as usize];
                     let turn0 = self.fin.turns.len() as u32;
-                    self.fin.turns.extend_from_slice(turns);
+                    self.fin.turns.extend_from_slice(path);
                     self.fin.out[s.index()] = Some(Member { turn0, ..*m });
                     self.fin.capped[s.index()] = capped;
                     self.fin.ran[s.index()] = round;
