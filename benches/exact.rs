@@ -3,8 +3,8 @@
 //! before timing). `cargo bench --bench exact`; the accuracy figures (energy
 //! drift over 10 million collisions, deepest overlap, escapes) print first.
 use ballpit::physics::exact::Exact;
-use ballpit::physics::exact::lattice;
 use ballpit::physics::{Model, Serial, World};
+use ballpit::scene::lattice;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::time::{Duration, Instant};
 

@@ -4,8 +4,8 @@
 //! counts only the event loop; divide by the collisions printed).
 //!
 //! `cargo run --release --example exact_rate -- 0.25 400000`
-use ballpit::physics::exact::lattice::melted;
 use ballpit::physics::{Model, Serial};
+use ballpit::scene::lattice::melted;
 use std::time::Instant;
 
 fn main() {

@@ -8,16 +8,25 @@
 //!
 //! `cargo run --release --example scaling -- [rounds] [sorted]`
 //!
-//! `cargo run --release --example scaling -- exact [rounds] [max N]`:
+//! `cargo run --release --example scaling -- exact [rounds] [max N] [renumber]`:
 //! the exact model at 10k, 100k and 1M spheres (up to `max N`), packing
-//! 0.005 and 0.1 (the radius set by N, the box 1, seed 5, as
+//! 0.005, 0.1 and 0.4 (the radius set by N, the box 1, seed 5, as
 //! `ballpit bench --count N --radius R --seed 5`). Per size: the time to
 //! load the spheres (the first advance, a step of 1e-9 s), the model's heap
 //! bytes per sphere, then blocks of steps of 2 ms (100 at 10k, 10 at 100k, 2
 //! at 1M) timed in alternation between the sizes: ns per sphere-step and
 //! events (collisions, crossings, walls, relists, stale) per second, and the
-//! 10k rate over that rate.
-//! `exact-one N packing steps [dt]` runs one size only (for callgrind).
+//! 10k rate over that rate. With `renumber` the model sorts its spheres
+//! again as they drift (default: only at load).
+//! `exact-one N packing steps [dt] [renumber]` runs one size only (for
+//! callgrind); with `renumber` the model sorts its spheres again as they
+//! drift.
+//! `exact-renumber N packing rounds [steps]`: one scene, two models, one
+//! relabelling its spheres in space as they drift (the default) and one
+//! keeping the load's order, run side by side on copies of the world in
+//! blocks of `steps` steps of 2 ms (default 20), timed in alternation:
+//! events per second of each, per round, as the spheres drift from where
+//! the load sorted them.
 //!
 //! With `sorted`, both worlds are sorted in space (by cell of the 10k
 //! scene's grid, z then y then x) before every block, outside the timing:
@@ -85,7 +94,8 @@ fn exact_one(args: &[String]) {
     let empty = status_kib("VmRSS");
     let mut world = exact_scene(n, packing);
     let (scene_peak, scene_rss) = (status_kib("VmHWM"), status_kib("VmRSS"));
-    let mut model = Exact::default();
+    let renumber = args.iter().any(|a| a == "renumber");
+    let mut model = Exact::default().with_renumbering(renumber);
     let start = Instant::now();
     model.advance(&mut world, 1e-9, 1, &Serial);
     let load = start.elapsed();
@@ -109,6 +119,61 @@ fn exact_one(args: &[String]) {
         per(status_kib("VmHWM")),
         ev as f64 / secs / 1e6,
         model.stats
+    );
+}
+
+fn exact_renumber(args: &[String]) {
+    let num = |k: usize| args.get(k).and_then(|a| a.parse::<f64>().ok());
+    let (n, packing, rounds) = (
+        num(0).expect("N") as usize,
+        num(1).expect("packing"),
+        num(2).expect("rounds") as usize,
+    );
+    let steps = num(3).map_or(20, |s| s as u64);
+    let world = exact_scene(n, packing);
+    let mut runs = [
+        (
+            "renumbered",
+            world.clone(),
+            Exact::default().with_renumbering(true),
+        ),
+        ("load order", world, Exact::default()),
+    ];
+    for (_, w, m) in &mut runs {
+        m.advance(w, 1e-9, 1, &Serial);
+    }
+    let e0 = events(&runs[0].2.stats);
+    let (mut total, mut spent) = ([0u64; 2], [0f64; 2]);
+    for round in 0..rounds {
+        let mut line = format!("round {round}:");
+        for (k, (name, w, m)) in runs.iter_mut().enumerate() {
+            // Untimed: the caches after the other model.
+            m.advance(w, DT_EXACT, 1, &Serial);
+            let before = events(&m.stats);
+            let start = Instant::now();
+            m.advance(w, DT_EXACT, steps, &Serial);
+            let secs = start.elapsed().as_secs_f64();
+            let ev = events(&m.stats) - before;
+            total[k] += ev;
+            spent[k] += secs;
+            line += &format!(
+                " {name} {:.3} M events/s ({} renumberings, {:.1} crossings+relists a sphere);",
+                ev as f64 / secs / 1e6,
+                m.stats.renumberings,
+                (m.stats.crossings + m.stats.relists) as f64 / n as f64
+            );
+        }
+        let rate = |k: usize| total[k] as f64 / spent[k];
+        println!(
+            "{line} so far renumbered/load order {:.2}",
+            rate(0) / rate(1)
+        );
+    }
+    println!(
+        "{n} spheres, packing {packing}: {} events a model; renumbered {:.3} M/s, load order {:.3} M/s",
+        events(&runs[0].2.stats) - e0,
+        total[0] as f64 / spent[0] / 1e6,
+        total[1] as f64 / spent[1] / 1e6
     );
 }
 
@@ -140,15 +205,16 @@ struct Run {
 fn exact_scaling(args: &[String]) {
     let rounds: usize = args.first().map_or(5, |r| r.parse().expect("rounds"));
     let max: usize = args.get(1).map_or(1_000_000, |m| m.parse().expect("max N"));
+    let renumber = args.iter().any(|a| a == "renumber");
     let sizes: Vec<usize> = [10_000, 100_000, 1_000_000]
         .into_iter()
         .filter(|&n| n <= max)
         .collect();
-    for packing in [0.005, 0.1] {
+    for packing in [0.005, 0.1, 0.4] {
         let mut runs = Vec::new();
         for &n in &sizes {
             let mut world = exact_scene(n, packing);
-            let mut model = Exact::default();
+            let mut model = Exact::default().with_renumbering(renumber);
             let start = Instant::now();
             model.advance(&mut world, 1e-9, 1, &Serial);
             let load = start.elapsed().as_secs_f64();
@@ -207,6 +273,7 @@ fn main() {
     match args.first().map(String::as_str) {
         Some("exact") => return exact_scaling(&args[1..]),
         Some("exact-one") => return exact_one(&args[1..]),
+        Some("exact-renumber") => return exact_renumber(&args[1..]),
         _ => {}
     }
     let sorted = args.iter().any(|a| a == "sorted");

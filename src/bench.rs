@@ -11,7 +11,8 @@ pub struct ThreadCpu {
 
 /// The fields of docs/design.md's bench JSON, plus `physics_threads`,
 /// `load_average`, `collisions_per_sim_second`, `temperature` and
-/// `capped_steps`.
+/// `capped_steps` (and `budget_steps`, those of them `swept`'s work budget
+/// stopped).
 #[derive(Debug, Serialize)]
 pub struct BenchReport {
     pub n: usize,
@@ -49,6 +50,7 @@ pub struct BenchReport {
     pub collisions_per_sim_second: f64,
     pub temperature: f64,
     pub capped_steps: u64,
+    pub budget_steps: u64,
     pub thread_cpu: Vec<ThreadCpu>,
     pub peak_rss_bytes: u64,
     /// Where the run could not keep a model's promise, and why (empty when
@@ -60,10 +62,17 @@ pub struct BenchReport {
 /// promises the run could not keep, and why.
 pub fn warnings(report: &BenchReport) -> Vec<String> {
     let mut w = Vec::new();
-    if report.capped_steps > 0 {
+    let events = report.capped_steps - report.budget_steps.min(report.capped_steps);
+    if events > 0 {
         w.push(format!(
             "{} steps hit the event cap and were finished in free flight, skipping contacts: overlaps up to {:.2e} r remain at the end (a smaller --dt or --speed avoids the cap)",
-            report.capped_steps, report.max_overlap_rel
+            events, report.max_overlap_rel
+        ));
+    }
+    if report.budget_steps > 0 {
+        w.push(format!(
+            "{} steps ran out of their work budget (too many contacts to follow in one step) and were finished in free flight, skipping contacts: overlaps up to {:.2e} r remain at the end (a smaller --dt or --speed avoids it)",
+            report.budget_steps, report.max_overlap_rel
         ));
     }
     if report.escaped > 0 {
@@ -170,6 +179,7 @@ pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(Ben
         },
         temperature: world.temperature(),
         capped_steps: c.capped_steps,
+        budget_steps: c.budget_steps,
         thread_cpu,
         peak_rss_bytes: peak_rss_bytes(),
         warnings: Vec::new(),

@@ -1,7 +1,7 @@
 //! The exact model against closed forms and its invariants.
 use ballpit::physics::exact::Exact;
-use ballpit::physics::exact::lattice::lattice_world;
 use ballpit::physics::{Model, Serial, Sphere, World};
+use ballpit::scene::lattice::lattice_world;
 use glam::DVec3;
 
 fn sphere(pos: [f64; 3], vel: [f64; 3], r: f64) -> Sphere {
@@ -250,4 +250,63 @@ fn observer_and_results_use_world_indices() {
     assert!((w.spheres[0].pos.z - 0.65).abs() < 1e-15);
     assert!((w.spheres[1].pos.z - 0.35).abs() < 1e-15);
     assert_eq!(w.spheres[2].pos, DVec3::splat(0.1));
+}
+
+/// Every contact of a run (world ids, time and impulse bits) and the final
+/// state, with `m`.
+fn record(mut w: World, m: Exact, dt: f64, steps: u64) -> (Vec<[u64; 4]>, World, u64) {
+    use std::sync::{Arc, Mutex};
+    let seen = Arc::new(Mutex::new(Vec::new()));
+    let sink = Arc::clone(&seen);
+    let mut m = m;
+    m.set_observer(Some(Box::new(move |c| {
+        let word = [
+            c.i as u64,
+            c.j as u64,
+            c.time.to_bits(),
+            c.impulse.to_bits(),
+        ];
+        sink.lock().expect("observer lock").push(word);
+    })));
+    let e0 = w.kinetic_energy();
+    m.advance(&mut w, dt, steps, &Serial);
+    check_invariants(&w, e0, 1e-10, 1e-9);
+    let contacts = seen.lock().expect("observer lock").clone();
+    (contacts, w, m.stats.renumberings)
+}
+
+/// Relabelling the spheres in space as they drift changes nothing anyone
+/// sees: the same contacts (lower world id first, the same impulse bits) in
+/// the same order and the same final state, bit for bit, as keeping the
+/// load's labels, with neighbour lists (dense) and with cells (dilute, a
+/// few large spheres among them).
+#[test]
+fn renumbering_in_space_changes_nothing_but_labels() {
+    let mut dilute = lattice_world(3000, 0.02, 1.0, 9).expect("lattice");
+    for (k, s) in dilute.spheres.iter_mut().step_by(1000).enumerate() {
+        // 3.5 to 4.3 times the rest: on the second level, clear of the
+        // lattice neighbours.
+        s.radius *= 3.5 + 0.4 * k as f64;
+        s.mass = s.radius.powi(3);
+    }
+    for (w, dt, steps) in [
+        (
+            lattice_world(3000, 0.4, 1.0, 7).expect("lattice"),
+            0.005,
+            60,
+        ),
+        (dilute, 0.01, 100),
+    ] {
+        let (kept, w_kept, none) = record(w.clone(), Exact::default(), dt, steps);
+        let (moved, w_moved, renumberings) =
+            record(w, Exact::default().with_renumbering(true), dt, steps);
+        assert_eq!(none, 0);
+        assert!(renumberings >= 3, "only {renumberings} renumberings");
+        assert!(kept.len() > 10_000, "only {} contacts", kept.len());
+        assert!(kept.iter().all(|c| c[0] < c[1]));
+        assert!(kept == moved, "the contacts differ");
+        for (a, b) in w_kept.spheres.iter().zip(&w_moved.spheres) {
+            assert_eq!((a.pos, a.vel), (b.pos, b.vel));
+        }
+    }
 }

@@ -14,9 +14,9 @@
 //! walls does not bias them. Tolerances (3 %, 5 % for the walls) sit well
 //! above the statistical and finite-size errors here (under 1 %) and well
 //! below what missing 5 % of the collisions does to both figures.
-use ballpit::physics::exact::lattice::lattice_world;
 use ballpit::physics::exact::{Contact, Exact};
 use ballpit::physics::{Counters, Model, Serial};
+use ballpit::scene::lattice::lattice_world;
 use glam::DVec3;
 use std::sync::{Arc, Mutex};
 

@@ -17,8 +17,8 @@
 //!   tunnel), so only its finiteness is checked.
 use assert_cmd::Command;
 use ballpit::physics::exact::Exact;
-use ballpit::physics::exact::lattice::lattice_world;
 use ballpit::physics::{Model, ModelKind, Serial, Sphere, World};
+use ballpit::scene::lattice::lattice_world;
 use glam::DVec3;
 
 const ENERGY: f64 = 1e-10;

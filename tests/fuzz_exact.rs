@@ -121,7 +121,7 @@ proptest! {
     ) {
         // Lattice starts (the neighbour-list broad phase above packing 0.3),
         // radii shrunk at random so sizes differ.
-        let mut w = ballpit::physics::exact::lattice::lattice_world(k * k * k, packing, 1.0, seed).unwrap();
+        let mut w = ballpit::scene::lattice::lattice_world(k * k * k, packing, 1.0, seed).unwrap();
         for (s, f) in w.spheres.iter_mut().zip(&shrink) {
             *s = Sphere::new(s.pos, s.vel, s.radius * f);
         }

@@ -166,6 +166,17 @@ fn readouts_panel_says_when_the_event_cap_was_hit() {
 }
 
 #[test]
+fn readouts_panel_says_when_the_work_budget_was_hit() {
+    let mut snap = snapshot();
+    snap.counters.capped_steps = 3;
+    snap.counters.budget_steps = 2;
+    let t = readouts(&state(), &snap, Palette::C16);
+    let text = format!("{:?}", t.backend().buffer());
+    assert!(text.contains("work budget hit in 3 steps"), "{text}");
+    assert!(!text.contains("event cap"), "{text}");
+}
+
+#[test]
 fn readouts_panel_says_exact_runs_on_one_thread_in_pool_mode() {
     let mut st = state();
     st.threading = Threading::Pool;

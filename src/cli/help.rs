@@ -60,7 +60,11 @@ pub const BENCH_FIELDS: &[(&str, &str)] = &[
     ("temperature", "mean kinetic energy per sphere, 2/3 x E/n"),
     (
         "capped_steps",
-        "steps that hit the model's event cap and were finished coarsely",
+        "steps that hit the model's event cap or work budget and were finished coarsely",
+    ),
+    (
+        "budget_steps",
+        "of capped_steps, those that ran out of swept's work budget per step",
     ),
     (
         "thread_cpu",

@@ -21,6 +21,12 @@ pub(crate) struct Detection {
     pub pairs: Vec<Pair>,
     /// Per block of spheres, in order, the ones `wall` picked.
     pub walls: Vec<Mutex<Vec<u32>>>,
+    /// Stop finding pairs once there are more than this (a step's work
+    /// budget, see `swept`); `None` finds them all.
+    pub pair_limit: Option<usize>,
+    /// Set by `run` when the pairs numbered more than `pair_limit`: then
+    /// `pairs` holds only some of them.
+    pub overran: bool,
 }
 
 impl Detection {
@@ -44,6 +50,7 @@ impl Detection {
         }
         self.walls.truncate(blocks);
         let slots = &self.walls;
+        let limit = self.pair_limit.unwrap_or(usize::MAX);
         let find_walls = |exec: &dyn Exec| {
             for_each_block(exec, blocks, &|b| {
                 let mut v = slots[b].lock();
@@ -57,19 +64,20 @@ impl Detection {
             })
         };
         if exec.functional() {
-            let pair_job = Mutex::new((&mut self.grid, &mut self.pairs));
+            let pair_job = Mutex::new((&mut self.grid, &mut self.pairs, true));
             exec.join(
                 &|| {
                     let mut job = pair_job.lock();
-                    let (grid, pairs) = &mut *job;
+                    let (grid, pairs, all) = &mut *job;
                     grid.build(spheres, size, &ball, &Serial);
-                    grid.pairs(&Serial, keep, pairs);
+                    *all = grid.pairs_within(&Serial, keep, pairs, limit);
                 },
                 &|| find_walls(&Serial),
             );
+            self.overran = !pair_job.into_inner().2;
         } else {
             self.grid.build(spheres, size, &ball, exec);
-            self.grid.pairs(exec, keep, &mut self.pairs);
+            self.overran = !self.grid.pairs_within(exec, keep, &mut self.pairs, limit);
             find_walls(exec);
         }
     }

@@ -20,6 +20,9 @@ pub struct Counters {
     /// Steps (or frames, for `exact`) that hit the event cap and were
     /// finished without resolving every contact.
     pub capped_steps: u64,
+    /// Of those, the steps stopped by `swept`'s work budget (the rest hit
+    /// an event cap).
+    pub budget_steps: u64,
 }
 
 /// The cube `[0, size]^3` and the spheres in it.

@@ -1,6 +1,7 @@
 //! Scenes: the presets, TOML scene files and sphere CSVs, turned into a
 //! checked [`World`].
 pub mod csv_io;
+pub mod lattice;
 pub mod place;
 pub mod presets;
 pub mod toml_file;

@@ -245,9 +245,15 @@ impl Readouts<'_> {
             Some(format!(" {n} "))
         } else if self.snap.counters.capped_steps > 0 {
             // A capped step skipped contacts: say so, it explains overlaps.
+            let c = &self.snap.counters;
+            let why = if c.budget_steps > 0 {
+                "work budget"
+            } else {
+                "event cap"
+            };
             Some(format!(
-                " event cap hit in {} steps: contacts skipped, overlaps possible ",
-                self.snap.counters.capped_steps
+                " {why} hit in {} steps: contacts skipped, overlaps possible (lower --dt or --speed) ",
+                c.capped_steps
             ))
         } else {
             None

@@ -302,7 +302,12 @@ impl Level {
     /// Same-level pairs with a sphere in key block `b`, each found once: a
     /// sphere against the rest of its cell and the next cell along x, and the
     /// cells x-1..=x+1 of the four forward rows.
-    pub(super) fn block_pairs(&self, b: usize, f: &mut impl FnMut(u32, u32)) {
+    pub(super) fn block_pairs(
+        &self,
+        b: usize,
+        go: &impl Fn() -> bool,
+        f: &mut impl FnMut(u32, u32),
+    ) {
         let keys = self.cell_start.len() - 1;
         let cs = &self.cell_start[..];
         let entries = &self.entries[..];
@@ -319,6 +324,9 @@ impl Level {
         // One sphere at a time, its windows looked up afresh: cells hold a
         // sphere or so, and state kept per cell spilled out of registers.
         for (i, e) in (lo..).zip(&entries[lo..hi]) {
+            if !go() {
+                return;
+            }
             let (a, ia) = (&e.ball, e.id);
             let (mut len, mut all) = (0, 0);
             for (lo, hi) in self.windows(i, e.key as usize) {

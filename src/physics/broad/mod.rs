@@ -13,6 +13,8 @@ use super::sphere::Sphere;
 use glam::DVec3;
 use level::{Ball, Entry, Level, within};
 use parking_lot::Mutex;
+use std::cell::Cell;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// At most this many spheres are tested against everything.
 const ALL_PAIRS_MAX: usize = 24;
@@ -22,6 +24,9 @@ const CROSS_BLOCK: usize = 64;
 const LANES_MIN_SPHERES: usize = 4096;
 /// Spheres per parallel block while binning.
 const BUILD_BLOCK: usize = 4096;
+/// Pairs a unit of [`Grid::pairs_within`] finds before it adds them to the
+/// shared total.
+const LIMIT_FLUSH: usize = 256;
 /// The first level's cell comes from every this-many-th reach.
 const SAMPLE_STRIDE: usize = 32;
 
@@ -222,13 +227,17 @@ impl Grid {
         units
     }
 
-    /// The pairs of one unit within reach, as `f(id, id)`.
-    fn unit_pairs(&self, unit: Unit, f: &mut impl FnMut(u32, u32)) {
+    /// The pairs of one unit within reach, as `f(id, id)`; `go` is asked
+    /// before each sphere's pairs, and the unit stops when it says no.
+    fn unit_pairs(&self, unit: Unit, go: &impl Fn() -> bool, f: &mut impl FnMut(u32, u32)) {
         match unit {
-            Unit::Block { level, block } => self.levels[level].block_pairs(block, f),
+            Unit::Block { level, block } => self.levels[level].block_pairs(block, go, f),
             Unit::Cross { level, from, to } => {
                 let coarse = &self.levels[level];
                 for e in &coarse.entries[from..to] {
+                    if !go() {
+                        return;
+                    }
                     let (a, ia) = (&e.ball, e.id);
                     for finer in &self.levels[..level] {
                         finer.near(a.pos, a.reach + finer.reach_max, &mut |j| {
@@ -242,6 +251,9 @@ impl Grid {
             }
             Unit::Top => {
                 for (k, (a, ia)) in self.top.iter().enumerate() {
+                    if !go() {
+                        return;
+                    }
                     for level in &self.levels {
                         level.near(a.pos, a.reach + level.reach_max, &mut |j| {
                             let b = &level.entries[j];
@@ -277,7 +289,7 @@ impl Grid {
         for_each_block(exec, units.len(), &|u| {
             let mut v = this.slots[u].lock();
             v.clear();
-            this.unit_pairs(units[u], &mut |i, j| {
+            this.unit_pairs(units[u], &|| true, &mut |i, j| {
                 if keep(i, j) {
                     v.push((i, j));
                 }
@@ -286,6 +298,69 @@ impl Grid {
         for s in &self.slots[..units.len()] {
             out.extend_from_slice(&s.lock());
         }
+    }
+
+    /// As [`Grid::pairs`], but stops once more than `limit` pairs are
+    /// found (a step's work budget); returns false then, with only some of
+    /// them in `out`. Every unit runs to its end unless the running total
+    /// is over `limit`, so the answer is "the pairs number more than
+    /// `limit`", whatever the lanes and their timing.
+    pub fn pairs_within<K: Fn(u32, u32) -> bool + Sync>(
+        &mut self,
+        exec: &dyn Exec,
+        keep: &K,
+        out: &mut Vec<Pair>,
+        limit: usize,
+    ) -> bool {
+        if limit == usize::MAX {
+            self.pairs(exec, keep, out);
+            return true;
+        }
+        out.clear();
+        let units = self.units();
+        while self.slots.len() < units.len() {
+            self.slots.push(Mutex::new(Vec::new()));
+        }
+        let this = &*self;
+        let found = AtomicUsize::new(0);
+        for_each_block(exec, units.len(), &|u| {
+            let mut v = this.slots[u].lock();
+            v.clear();
+            // Counted here, added to the total now and then: one shared
+            // counter touched per pair would cost more than the pair.
+            // The total is read then too: a unit that finds few pairs costs
+            // little, whatever the others found.
+            let (mine, told, over) = (Cell::new(0usize), Cell::new(0usize), Cell::new(false));
+            let tell = || {
+                let new = mine.get() - told.get();
+                let before = found.fetch_add(new, Ordering::Relaxed);
+                told.set(mine.get());
+                over.set(before + new > limit);
+            };
+            let go = || {
+                if mine.get() - told.get() >= LIMIT_FLUSH {
+                    tell();
+                }
+                !over.get()
+            };
+            over.set(found.load(Ordering::Relaxed) > limit);
+            if go() {
+                this.unit_pairs(units[u], &go, &mut |i, j| {
+                    if keep(i, j) {
+                        v.push((i, j));
+                        mine.set(mine.get() + 1);
+                    }
+                });
+            }
+            tell();
+        });
+        if found.into_inner() > limit {
+            return false;
+        }
+        for s in &self.slots[..units.len()] {
+            out.extend_from_slice(&s.lock());
+        }
+        true
     }
 
     /// Every sphere whose ball may meet a ball of radius `reach` around `p`,

@@ -5,20 +5,24 @@
 //! - lazy update: each sphere carries its own time stamp ([`body`]) and is
 //!   moved only when an event touches it or when `advance` returns;
 //! - one pending event per sphere (the earliest of contact, wall, or its
-//!   broad-phase event), in a tournament tree ([`queue`]);
+//!   broad-phase event), in an [`EventQueue`] (a tournament tree);
 //! - a broad phase chosen by packing fraction ([`LISTS_ABOVE_PACKING`]):
-//!   cells with cell-crossing events for dilute and moderate scenes
-//!   ([`cells`]), neighbour lists with a skin for dense ones
-//!   ([`neighbours`]); both keep the few spheres far larger than the bulk on
-//!   a second level, so radii 100x apart stay cheap;
-//! - stale predictions detected by per-sphere collision counts ([`schedule`]).
+//!   a cell grid with cell-crossing events for dilute and moderate scenes
+//!   ([`cell_grid`]), neighbour lists with a skin for dense ones
+//!   ([`neighbour_lists`]); both keep the few spheres far larger than the
+//!   bulk on a second level ([`large`]), so radii 100x apart stay cheap;
+//! - stale predictions detected by per-sphere collision counts ([`schedule`]);
+//! - spheres sorted in space at load, and on request relabelled again as
+//!   they drift ([`renumber`]); the world keeps every sphere at its id.
 //!
 //! Time of impact comes from [`pair_toi`](crate::physics::contact::pair_toi)
 //! (stable quadratic, rounding guard: overlapping and approaching collides
 //! now, receding is left alone). Simultaneous events are processed in a
 //! fixed order: by the sphere whose prediction it is, in the model's
-//! internal order (spatially sorted when the schedule is built, a pure
-//! function of the world); a sphere's own candidates tie its broad-phase
+//! internal order (sorted in space at load, and, if asked, again as the
+//! spheres drift, [`renumber`]: a pure function of the world and its history; a contact
+//! taken by either of its spheres is the same contact, bit for bit, and is
+//! reported lower world id first); a sphere's own candidates tie its broad-phase
 //! event (relist or crossing) first, then walls, then partners in the order
 //! the broad phase offers them.
 //! Runs are therefore reproducible, and the event loop runs on one thread
@@ -37,12 +41,11 @@
 //! (contacts in its remainder are missed, so overlaps may then appear), and
 //! the schedule is rebuilt for the next step.
 pub mod body;
-pub mod cell_list;
-pub mod cell_slots;
-pub mod cells;
-pub mod lattice;
-pub mod neighbours;
+pub mod cell_grid;
+pub mod large;
+pub mod neighbour_lists;
 pub mod queue;
+pub mod renumber;
 pub mod schedule;
 
 use super::contact::{reflect_walls, resolve_pair};
@@ -51,10 +54,11 @@ use super::flight::fly;
 use super::model::{Model, ModelKind};
 use super::world::{Counters, World};
 use body::Body;
-use cells::Cells;
+use cell_grid::CellGrid;
 use glam::DVec3;
-use neighbours::Neighbours;
-use queue::EventQueue;
+use neighbour_lists::NeighbourLists;
+pub use queue::EventQueue;
+use queue::Tournament;
 use schedule::{Event, Kind, Predictor};
 
 /// Events (contacts, wall hits, relists, stale predictions) a step may take,
@@ -64,6 +68,8 @@ pub const EVENT_CAP_PER_SPHERE: u64 = 100;
 /// Internal times are kept relative to an origin that moves with the frames,
 /// so lazy positions `x + v (t - t_i)` never subtract large times.
 const ORIGIN_SPAN: f64 = 1.0;
+/// "No sphere" / "no cell" in the broad phases' `u32` indices.
+pub const NONE: u32 = u32::MAX;
 
 /// Above this packing fraction the broad phase is neighbour lists (a
 /// sphere's free path is short, so it meets its skin's edge rarely and
@@ -76,8 +82,8 @@ pub const LISTS_ABOVE_PACKING: f64 = 0.3;
 /// each rebuild.
 #[derive(Clone, Debug)]
 enum Broad {
-    Lists(Box<Neighbours>),
-    Cells(Box<Cells>),
+    Lists(Box<NeighbourLists>),
+    Cells(Box<CellGrid>),
 }
 
 impl Default for Broad {
@@ -102,8 +108,14 @@ pub struct Contact {
 
 pub type Observer = Box<dyn FnMut(&Contact) + Send>;
 
+/// The model, with today's event queue.
+pub type Exact = EventDriven<Tournament>;
+
+/// The model over an event queue `Q` (one implementation today; a type
+/// parameter, so another can be tried without touching the loop, at no cost
+/// to this one).
 #[derive(Default)]
-pub struct Exact {
+pub struct EventDriven<Q: EventQueue> {
     bodies: Vec<Body>,
     mass: Vec<f64>,
     /// World index of each body: bodies are kept in a spatial order (sorted
@@ -115,7 +127,7 @@ pub struct Exact {
     /// Cell mode: each sphere's best contact or wall event (absolute time),
     /// kept apart from its crossing so a crossing rescans only new cells.
     pending: Vec<(f64, Event)>,
-    queue: EventQueue,
+    queue: Q,
     broad: Broad,
     /// Scratch for the candidates a prediction gathers.
     candidates: Vec<u32>,
@@ -127,6 +139,11 @@ pub struct Exact {
     valid: bool,
     cap: Option<u64>,
     cells_per_sphere: Option<u32>,
+    /// Sort the spheres in space again as they drift (off by default: it
+    /// measured slower, see docs/benchmarks.md "exact at scale").
+    renumbering: bool,
+    /// Broad-phase events (crossings, relists) at the last spatial sort.
+    sorted_at: u64,
     observer: Option<Observer>,
     /// Events processed since construction, by kind.
     pub stats: EventStats,
@@ -143,9 +160,11 @@ pub struct EventStats {
     pub crossings: u64,
     /// Full rebuilds of the schedule (start, outside changes, capped steps).
     pub rebuilds: u64,
+    /// Spatial re-sorts of the spheres ([`renumber`]).
+    pub renumberings: u64,
 }
 
-impl Exact {
+impl<Q: EventQueue> EventDriven<Q> {
     /// Set the events a step may take (default: [`EVENT_CAP_BASE`] plus
     /// [`EVENT_CAP_PER_SPHERE`] per sphere).
     pub fn with_event_cap(mut self, cap: u64) -> Self {
@@ -154,9 +173,16 @@ impl Exact {
     }
 
     /// Set the most cells per sphere of the cell grid (default
-    /// [`cells::CELLS_PER_SPHERE`]; at least 1), for comparing grids.
+    /// [`cell_grid::CELLS_PER_SPHERE`]; at least 1), for comparing grids.
     pub fn with_cells_per_sphere(mut self, k: u32) -> Self {
         self.cells_per_sphere = Some(k.max(1));
+        self
+    }
+
+    /// Sort the spheres by cell again as they drift (default: only at
+    /// load), for comparing the two.
+    pub fn with_renumbering(mut self, on: bool) -> Self {
+        self.renumbering = on;
         self
     }
 
@@ -207,28 +233,7 @@ impl Exact {
         self.size = world.size;
         self.origin = world.time;
         self.synced_time = world.time;
-        let n = world.spheres.len();
-        let side = ((n as f64).cbrt().ceil() as usize).max(1);
-        let cell = |x: f64| ((x / world.size * side as f64) as usize).min(side - 1);
-        let key =
-            |p: DVec3| cell(p.x.max(0.0)) + side * (cell(p.y.max(0.0)) + side * cell(p.z.max(0.0)));
-        // A counting sort by cell: linear, and stable (ties in world order),
-        // so the order is the one a stable sort by key gives.
-        let keys: Vec<u32> = world.spheres.iter().map(|s| key(s.pos) as u32).collect();
-        let mut start = vec![0u32; side * side * side + 1];
-        for &k in &keys {
-            start[k as usize + 1] += 1;
-        }
-        for c in 1..start.len() {
-            start[c] += start[c - 1];
-        }
-        self.order.clear();
-        self.order.resize(n, 0);
-        for (i, &k) in keys.iter().enumerate() {
-            let at = &mut start[k as usize];
-            self.order[*at as usize] = i as u32;
-            *at += 1;
-        }
+        self.order = renumber::spatial_order(world.spheres.iter().map(|s| s.pos), world.size);
         self.bodies.clear();
         self.bodies.extend(
             self.order
@@ -238,6 +243,7 @@ impl Exact {
         self.mass.clear();
         self.mass
             .extend(self.order.iter().map(|&k| world.spheres[k as usize].mass));
+        self.sorted_at = self.stats.crossings + self.stats.relists;
         self.reschedule_all();
     }
 
@@ -257,15 +263,15 @@ impl Exact {
             .map(|b| crate::physics::sphere::volume(b.radius))
             .sum();
         if filled > LISTS_ABOVE_PACKING * self.size.powi(3) {
-            let mut nl = Box::<Neighbours>::default();
+            let mut nl = Box::<NeighbourLists>::default();
             nl.build(&self.bodies, self.size);
             self.broad = Broad::Lists(nl);
             // Only cells keep a pending event apart from the broad phase's.
             self.pending = Vec::new();
         } else {
             self.pending.resize(n, (f64::INFINITY, Event::default()));
-            let mut cells = Box::<Cells>::default();
-            let per_sphere = self.cells_per_sphere.unwrap_or(cells::CELLS_PER_SPHERE);
+            let mut cells = Box::<CellGrid>::default();
+            let per_sphere = self.cells_per_sphere.unwrap_or(cell_grid::CELLS_PER_SPHERE);
             cells.build(&self.bodies, self.size, per_sphere);
             self.broad = Broad::Cells(cells);
         }
@@ -465,17 +471,24 @@ impl Exact {
     fn collide(&mut self, i: usize, j: usize, c: &mut Counters) {
         let mut a = self.bodies[i].sphere(self.mass[i]);
         let mut b = self.bodies[j].sphere(self.mass[j]);
-        let before = a.vel;
+        let before = [a.vel, b.vel];
         if resolve_pair(&mut a, &mut b) {
             c.sphere_collisions += 1;
             if let Some(f) = &mut self.observer {
+                // Lower world id first, whichever of the two predicted the
+                // contact (labels decide that on a tie; `resolve_pair` gives
+                // the same velocities either way round, bit for bit), so
+                // observers see the same contact whatever the labels.
+                let (ids, spheres) = ([self.order[i], self.order[j]], [&a, &b]);
+                let lo = usize::from(ids[1] < ids[0]);
+                let (p, q) = (spheres[lo], spheres[1 - lo]);
                 f(&Contact {
                     time: self.origin + self.bodies[i].t,
-                    i: self.order[i] as usize,
-                    j: self.order[j] as usize,
-                    pos_i: a.pos,
-                    pos_j: b.pos,
-                    impulse: a.mass * (a.vel - before).length(),
+                    i: ids[lo] as usize,
+                    j: ids[1 - lo] as usize,
+                    pos_i: p.pos,
+                    pos_j: q.pos,
+                    impulse: p.mass * (p.vel - before[lo]).length(),
                 });
             }
         }
@@ -508,7 +521,7 @@ impl Exact {
     }
 }
 
-impl Model for Exact {
+impl<Q: EventQueue + Send> Model for EventDriven<Q> {
     fn kind(&self) -> ModelKind {
         ModelKind::Exact
     }
@@ -526,6 +539,15 @@ impl Model for Exact {
                 self.reorigin(world.time);
             }
             let target = end - self.origin;
+            // Once the spheres have crossed about a cell each, on average.
+            let moved = self.stats.crossings + self.stats.relists;
+            if self.valid
+                && self.renumbering
+                && moved - self.sorted_at >= self.bodies.len().max(1) as u64
+            {
+                self.renumber();
+                self.sorted_at = moved;
+            }
             if !self.valid {
                 for b in &mut self.bodies {
                     b.advance(world.time - self.origin);

@@ -1,12 +1,38 @@
-//! The event queue: one pending event per sphere, kept in a tournament tree
-//! (a complete binary tree whose every inner node holds the earlier of its two
-//! children). DynamO and Smallenburg's EDMD also keep one event per particle;
-//! the tree makes "replace sphere i's event" and "peek the earliest" O(log N)
-//! and O(1) with no allocation and no stale entries, which a binary heap of
-//! all predictions would accumulate.
-//!
-//! Simultaneous events pop in sphere-index order (lower index first): the
-//! fixed order that makes runs reproducible.
+//! The event queue: one pending event per sphere ([`EventQueue`]), and the
+//! one implementation, a tournament tree ([`Tournament`]: a complete binary
+//! tree whose every inner node holds the earlier of its two children).
+//! DynamO and Smallenburg's EDMD also keep one event per particle; the tree
+//! makes "replace sphere i's event" and "peek the earliest" O(log N) and
+//! O(1) with no allocation and no stale entries, which a binary heap of all
+//! predictions would accumulate.
+
+/// The earliest of one pending event time per sphere. Simultaneous events
+/// pop in sphere-index order (lower index first): the fixed order that makes
+/// runs reproducible, so another queue must keep it to give the same runs.
+pub trait EventQueue: Default {
+    /// Spheres `0..n`, every event at infinity.
+    fn reset(&mut self, n: usize);
+    /// Set sphere `i`'s time without restoring the order; call
+    /// [`Self::rebuild`] after setting them all.
+    fn set_leaf(&mut self, i: usize, t: f64);
+    /// Restore the order after [`Self::set_leaf`]s.
+    fn rebuild(&mut self);
+    /// Sphere `i`'s pending event is now at `t`.
+    fn update(&mut self, i: usize, t: f64);
+    /// Spheres `i` and `j` (the two of a contact) are now at `ti` and `tj`.
+    fn update_two(&mut self, i: usize, ti: f64, j: usize, tj: f64) {
+        self.update(i, ti);
+        self.update(j, tj);
+    }
+    /// The earliest pending event: time and sphere (time infinite if none).
+    fn peek(&self) -> (f64, usize);
+    /// Time of sphere `i`'s pending event.
+    fn time_of(&self, i: usize) -> f64;
+    /// Subtract `shift` from every time (a new time origin).
+    fn shift(&mut self, shift: f64);
+    /// Bytes held on the heap.
+    fn heap_bytes(&self) -> usize;
+}
 
 /// A time as a `u64` whose unsigned order is the time's order (`-0` is
 /// taken as `+0`, so the two tie as before): the climb compares integers,
@@ -24,7 +50,7 @@ fn time(key: u64) -> f64 {
 }
 
 #[derive(Clone, Debug, Default)]
-pub struct EventQueue {
+pub struct Tournament {
     /// Node `k`: the key of its event's time and the sphere. Leaves are
     /// nodes `size..2*size`, the root is node 1; node 0 is unused. Keys and
     /// spheres apart, so a climb carries the winning key in a register and
@@ -50,14 +76,20 @@ fn step(keys: &mut [u64], ids: &mut [u32], mask: usize, k: usize, w: u64) -> u64
     w
 }
 
-impl EventQueue {
+impl EventQueue for Tournament {
+    /// Time of sphere `i`'s pending event.
+    #[inline]
+    fn time_of(&self, i: usize) -> f64 {
+        time(self.keys[self.size + i])
+    }
+
     /// Bytes held on the heap.
-    pub fn heap_bytes(&self) -> usize {
+    fn heap_bytes(&self) -> usize {
         self.keys.capacity() * 8 + self.ids.capacity() * 4
     }
 
     /// A queue for spheres `0..n`, every event at infinity.
-    pub fn reset(&mut self, n: usize) {
+    fn reset(&mut self, n: usize) {
         self.size = n.next_power_of_two().max(1);
         self.keys.clear();
         self.keys.resize(2 * self.size, key(f64::INFINITY));
@@ -67,12 +99,12 @@ impl EventQueue {
 
     /// Set the leaves without rebuilding the tree; call [`Self::rebuild`] after.
     #[inline]
-    pub fn set_leaf(&mut self, i: usize, t: f64) {
+    fn set_leaf(&mut self, i: usize, t: f64) {
         self.keys[self.size + i] = key(t);
         self.ids[self.size + i] = i as u32;
     }
 
-    pub fn rebuild(&mut self) {
+    fn rebuild(&mut self) {
         for k in (1..self.size).rev() {
             let right = (self.keys[2 * k + 1] < self.keys[2 * k]) as usize;
             self.keys[k] = self.keys[2 * k + right];
@@ -80,22 +112,11 @@ impl EventQueue {
         }
     }
 
-    /// The two arrays as slices of one power-of-two length, and that length
-    /// less one (`None` before any reset).
-    #[inline(always)]
-    fn nodes(&mut self) -> Option<(&mut [u64], &mut [u32], usize)> {
-        let len = self.keys.len();
-        if len == 0 {
-            return None;
-        }
-        Some((&mut self.keys[..len], &mut self.ids[..len], len - 1))
-    }
-
     /// Sphere `i`'s pending event is now at `t`. Climbs to the root always:
     /// stopping early where the winner stays saves little, and a branch on
     /// either the stop or the comparison is taken at random.
     #[inline]
-    pub fn update(&mut self, i: usize, t: f64) {
+    fn update(&mut self, i: usize, t: f64) {
         let mut k = self.size + i;
         let Some((keys, ids, mask)) = self.nodes() else {
             return;
@@ -112,7 +133,7 @@ impl EventQueue {
     /// [`Self::update`] for two spheres at once (the two of a contact): each
     /// climbs to where their paths meet, and the rest is climbed once.
     #[inline]
-    pub fn update_two(&mut self, i: usize, ti: f64, j: usize, tj: f64) {
+    fn update_two(&mut self, i: usize, ti: f64, j: usize, tj: f64) {
         if i == j {
             self.update(i, ti);
             return self.update(j, tj);
@@ -143,23 +164,30 @@ impl EventQueue {
 
     /// The earliest pending event: time and sphere (time infinite if none).
     #[inline]
-    pub fn peek(&self) -> (f64, usize) {
+    fn peek(&self) -> (f64, usize) {
         (time(self.keys[1]), self.ids[1] as usize)
-    }
-
-    /// Time of sphere `i`'s pending event.
-    #[inline]
-    pub fn time_of(&self, i: usize) -> f64 {
-        time(self.keys[self.size + i])
     }
 
     /// Subtract `shift` from every time (a new time origin); order is kept
     /// because subtraction of a constant is monotone under rounding.
-    pub fn shift(&mut self, shift: f64) {
+    fn shift(&mut self, shift: f64) {
         for k in &mut self.keys[self.size..] {
             *k = key(time(*k) - shift);
         }
         self.rebuild();
+    }
+}
+
+impl Tournament {
+    /// The two arrays as slices of one power-of-two length, and that length
+    /// less one (`None` before any reset).
+    #[inline(always)]
+    fn nodes(&mut self) -> Option<(&mut [u64], &mut [u32], usize)> {
+        let len = self.keys.len();
+        if len == 0 {
+            return None;
+        }
+        Some((&mut self.keys[..len], &mut self.ids[..len], len - 1))
     }
 }
 
@@ -169,7 +197,7 @@ mod tests {
 
     #[test]
     fn pops_in_time_then_index_order() {
-        let mut q = EventQueue::default();
+        let mut q = Tournament::default();
         q.reset(5);
         for (i, t) in [3.0, 1.0, 2.0, 1.0, 5.0].into_iter().enumerate() {
             q.set_leaf(i, t);
@@ -187,7 +215,7 @@ mod tests {
 
     #[test]
     fn update_moves_an_event_both_ways() {
-        let mut q = EventQueue::default();
+        let mut q = Tournament::default();
         q.reset(3);
         for i in 0..3 {
             q.set_leaf(i, i as f64);
@@ -208,7 +236,7 @@ mod tests {
         use rand::{Rng, SeedableRng};
         let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(5);
         for n in [2, 3, 64, 100] {
-            let (mut one, mut two) = (EventQueue::default(), EventQueue::default());
+            let (mut one, mut two) = (Tournament::default(), Tournament::default());
             one.reset(n);
             two.reset(n);
             for _ in 0..3000 {
@@ -254,7 +282,7 @@ mod tests {
         use rand::{Rng, SeedableRng};
         let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(3);
         for n in [1, 2, 3, 5, 64, 100] {
-            let mut q = EventQueue::default();
+            let mut q = Tournament::default();
             q.reset(n);
             let mut times = vec![f64::INFINITY; n];
             q.rebuild();

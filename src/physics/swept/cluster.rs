@@ -27,6 +27,15 @@ const SMALL_RUN: usize = 32;
 /// constants").
 const GROWTH_CAP: f64 = 1.25;
 
+/// An event's own cost in pair checks: the queue, the grid cells its
+/// rescans visit, its turns kept and compared (measured: about 400 pair
+/// checks' time in the close-packed lattice, where events dominate).
+pub(super) const EVENT_WORK: u64 = 256;
+/// What a sphere a rescan finds within reach costs beyond its check (a
+/// sort, a path solved), in pair checks (measured at `--speed 1e4`, where
+/// rescans find much of the box).
+const FOUND_WORK: u64 = 4;
+
 /// What every run of a step reads: the state at the start of the step and
 /// who has events.
 pub(super) struct Shared<'a> {
@@ -40,6 +49,8 @@ pub(super) struct Shared<'a> {
     pub partners: &'a [u32],
     pub size: f64,
     pub dt: f64,
+    /// Work (see [`Run::work`]) a run may do per member it starts with.
+    pub work_per_member: u64,
 }
 
 impl Shared<'_> {
@@ -50,6 +61,16 @@ impl Shared<'_> {
         let end = *self.partner_start.get(s.checked_add(1)?)?;
         Some(&self.partners[self.partner_start[s] as usize..end as usize])
     }
+}
+
+/// Why a run stopped taking events and finished in free flight.
+/// Ordered by weight: a step with both says "work".
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Coarse {
+    /// More events than the cap for its members.
+    Events,
+    /// More work than its share of the step's budget.
+    Work,
 }
 
 /// An event; `a`, `b` are sphere ids (`b` NONE for a wall), `la`, `lb` the
@@ -150,8 +171,12 @@ pub(super) struct Run {
     /// (member, member of another cluster) whose balls met: the caller
     /// compares their paths when both runs are done.
     pub cross: Vec<(u32, u32)>,
-    /// Set when the run hit its event cap.
-    pub capped: bool,
+    /// Set when the run hit its event cap or its work budget.
+    pub capped: Option<Coarse>,
+    /// Pair checks made: the pairs handed in, every sphere a rescan looked
+    /// at, and [`EVENT_WORK`] per event. Counted, not timed, so a capped run
+    /// is the same on any machine and any lanes.
+    pub work: u64,
 }
 
 impl Run {
@@ -180,6 +205,8 @@ impl Run {
             }
         }
         let cap = 10_000 + 64 * self.ids.len();
+        let work_cap = sh.work_per_member.saturating_mul(self.ids.len() as u64);
+        self.work = pairs.len() as u64;
         let mut done = 0usize;
         while let Some(e) = self.heap.pop() {
             let (la, lb) = (e.la as usize, e.lb as usize);
@@ -187,8 +214,13 @@ impl Run {
                 continue;
             }
             done += 1;
+            self.work += EVENT_WORK;
             if done > cap {
-                self.capped = true;
+                self.capped = Some(Coarse::Events);
+                break;
+            }
+            if self.work > work_cap {
+                self.capped = Some(Coarse::Work);
                 break;
             }
             self.advance_to(la, e.t);
@@ -225,7 +257,7 @@ impl Run {
                 continue;
             }
             let rest = sh.dt - self.t_local[l];
-            if !self.capped {
+            if self.capped.is_none() {
                 // Every wall it reaches before the step ends was an event:
                 // the rest of its path is straight.
                 let s = &mut self.sp[l];
@@ -305,7 +337,8 @@ impl Run {
         self.pair_hits.clear();
         self.heap.clear();
         self.turn_log.clear();
-        self.capped = false;
+        self.capped = None;
+        self.work = 0;
         self.cross.clear();
     }
 
@@ -377,10 +410,12 @@ impl Run {
             (sa.radius + sa.vel.length() * rem) * REACH_SLACK,
         );
         let this = &*self;
+        let mut seen = 0u64;
         if !absorb && self.ids.len() <= SMALL_RUN {
             // Members are few: they are checked one by one with their grown
             // balls, so the grid is searched only for non-members.
             let mut non_member = |j: u32, pj0: DVec3, rj: f64| {
+                seen += 1;
                 // The distance first: it reads what the grid handed over,
                 // the member table is a read elsewhere in memory.
                 if q.distance_squared(pj0) <= (rq + rj) * (rq + rj) && this.member(j).is_none() {
@@ -401,6 +436,7 @@ impl Run {
                 }
                 None => sh.grid.near(q, rq, 1.0, &mut non_member),
             }
+            seen += this.ids.len() as u64;
             for l in 0..this.ids.len() {
                 let r = rq + this.reach[l];
                 if l != la && q.distance_squared(this.centre[l]) <= r * r {
@@ -413,6 +449,7 @@ impl Run {
             // cap is no longer found through the grid, so `grown` is
             // checked by hand.
             let mut consider = |j: u32, pj0: DVec3, rj: f64| {
+                seen += 1;
                 let rj = this.member(j).map_or(rj, |l| this.reach[l]);
                 if q.distance_squared(pj0) <= (rq + rj) * (rq + rj) {
                     found.push(j);
@@ -424,6 +461,8 @@ impl Run {
                 consider(this.ids[lg], this.centre[lg], this.reach[lg]);
             }
         }
+        // A sphere found within reach is sorted and its path solved too.
+        self.work += seen + FOUND_WORK * found.len() as u64;
         found.sort_unstable();
         found.dedup();
         for &j in &found {

@@ -3,7 +3,7 @@
 //! (noted by a run, or grown balls found by a grid over all of them) are
 //! compared turn by turn, and those that come within touching distance are
 //! conflicts: their clusters merge and run again.
-use super::cluster::{Member, Turn};
+use super::cluster::{Coarse, Member, Turn};
 use super::partition::{Partition, Slot};
 use super::path_ball;
 use super::rounds::RoundStats;
@@ -21,8 +21,8 @@ const LANES_MIN_BALLS: usize = 2048;
 pub(super) struct Finished {
     /// The member's end of the step and path (None until its cluster ran).
     pub out: Vec<Option<Member>>,
-    /// Whether that run hit its event cap.
-    pub capped: Vec<bool>,
+    /// Whether (and why) that run was capped.
+    pub capped: Vec<Option<Coarse>>,
     /// The round that run was made in (NONE before any).
     pub ran: Vec<u32>,
     /// Every finished member's turns (`Member::turn0` indexes here).
@@ -34,7 +34,7 @@ impl Finished {
         self.out.clear();
         self.out.resize(m, None);
         self.capped.clear();
-        self.capped.resize(m, false);
+        self.capped.resize(m, None);
         self.ran.clear();
         self.ran.resize(m, super::NONE);
         self.turns.clear();
@@ -43,7 +43,7 @@ impl Finished {
     /// Room for a slot added after the first round.
     pub fn push(&mut self) {
         self.out.push(None);
-        self.capped.push(false);
+        self.capped.push(None);
         self.ran.push(super::NONE);
     }
 
@@ -52,7 +52,7 @@ impl Finished {
     /// or one not run) meets everyone: a merge costs time, never a result.
     fn meet(&self, a: usize, b: usize, spheres: &[Sphere], dt: f64) -> bool {
         let path = |s: usize| {
-            let m = self.out[s].filter(|_| !self.capped[s])?;
+            let m = self.out[s].filter(|_| self.capped[s].is_none())?;
             let turns = &self.turns[m.turn0 as usize..(m.turn0 + m.turns) as usize];
             Some((&spheres[m.id as usize], turns))
         };

@@ -4,8 +4,10 @@
 //! only when touched (lazy update). Whenever a contact changes a velocity,
 //! that sphere looks again for partners within its reach, so chains of
 //! contacts inside a step are followed, not missed. The rest fly straight.
-//! A pathological step (near jamming) is cut off by an event cap, finished
-//! in free flight and counted in `capped_steps`.
+//! A pathological step (near jamming, or paths that cross much of the box)
+//! is cut off by an event cap or by the step's work budget (pair checks,
+//! counted, so the same on any machine), finished in free flight with wall
+//! bounces and counted in `capped_steps` (`budget_steps` for the budget).
 //!
 //! The spheres with events are cut into clusters that cannot touch each
 //! other, each with its own event queue, run side by side on the executor's
@@ -27,9 +29,11 @@ use super::broad::Pair;
 use super::contact::pair_toi;
 use super::detect::{Detection, SPHERE_BLOCK};
 use super::exec::{Exec, for_each_block, for_each_chunk};
+use super::flight::fly;
 use super::model::{Model, ModelKind};
 use super::sphere::Sphere;
 use super::world::World;
+use cluster::Coarse;
 use glam::DVec3;
 use parking_lot::Mutex;
 pub use parts::ADDED_PAIRS;
@@ -43,6 +47,12 @@ const REACH_SLACK: f64 = 1.0 + 1e-9;
 /// Candidate pairs per parallel block when sorting them into meeting and
 /// merely near.
 const PAIR_BLOCK: usize = 4096;
+/// The work budget of one step, in pair checks (pairs detection finds,
+/// spheres a rescan looks at, weights per event: `cluster.rs`): a base plus
+/// so much per sphere, so the worst step of 1 000 spheres (120 M) costs
+/// under a second of CPU here (docs/benchmarks.md).
+const BUDGET_BASE: u64 = 20_000_000;
+const BUDGET_PER_SPHERE: u64 = 100_000;
 
 #[derive(Default)]
 pub struct Swept {
@@ -64,6 +74,8 @@ pub struct Swept {
     last_parts: u32,
     /// Detection already made for the next step of the world it names.
     ahead: Option<Ahead>,
+    /// The work budget per step, when not the default one: (base, per sphere).
+    budget: Option<(u64, u64)>,
 }
 
 /// A detection made ahead of its step (when the engine asked for the
@@ -74,6 +86,17 @@ struct Ahead {
     dt: f64,
     key: WorldKey,
     overlap: f64,
+    /// The detection found more pairs than a step's budget allows.
+    overran: bool,
+}
+
+/// How a part of a step ended.
+enum PartEnd {
+    /// Its events ran, all of them or up to a cap (which one).
+    Ran(Option<Coarse>),
+    /// Its detection alone found more pairs than the budget left: the world
+    /// is as it was.
+    Overran,
 }
 
 /// What a detection made ahead is valid for: a world of this generation
@@ -118,13 +141,22 @@ impl Model for Swept {
             let k = self.parts_of(world, dt);
             self.last_parts = k;
             let part = dt / f64::from(k);
-            let mut capped = false;
+            let mut capped = None;
+            let mut left = self.budget_of(world.spheres.len());
             self.step_stats = RoundStats::default();
-            for _ in 0..k {
-                capped |= self.step(world, part, exec);
+            for p in 0..k {
+                let PartEnd::Ran(cap) = self.step(world, part, exec, &mut left) else {
+                    // Out of budget: the rest of the step in free flight.
+                    fly_all(world, part * f64::from(k - p));
+                    capped = Some(Coarse::Work);
+                    break;
+                };
                 self.step_stats.add(&self.rounds.stats);
+                // A part stopped by the budget outranks one by the cap.
+                capped = capped.max(cap);
             }
-            world.counters.capped_steps += u64::from(capped);
+            world.counters.capped_steps += u64::from(capped.is_some());
+            world.counters.budget_steps += u64::from(capped == Some(Coarse::Work));
             world.time += dt;
         }
     }
@@ -150,11 +182,19 @@ impl Model for Swept {
             && a.dt == dt
             && a.key == key
         {
-            return Some(a.overlap);
+            return (!a.overran).then_some(a.overlap);
         }
-        let overlap = self.detect(world, dt, exec);
-        self.ahead = Some(Ahead { dt, key, overlap });
-        Some(overlap)
+        let limit = self.budget_of(world.spheres.len());
+        let overlap = self.detect(world, dt, exec, limit);
+        let overran = self.detect.overran;
+        self.ahead = Some(Ahead {
+            dt,
+            key,
+            overlap,
+            overran,
+        });
+        // Only some pairs were found: the engine measures the overlap itself.
+        (!overran).then_some(overlap)
     }
 }
 
@@ -184,17 +224,37 @@ impl Swept {
         self
     }
 
-    /// One part of a step (see `parts.rs`); returns whether it hit the
-    /// event cap.
-    fn step(&mut self, world: &mut World, dt: f64, exec: &dyn Exec) -> bool {
+    /// The work budget for a step of `n` spheres.
+    fn budget_of(&self, n: usize) -> u64 {
+        let (base, per) = self.budget.unwrap_or((BUDGET_BASE, BUDGET_PER_SPHERE));
+        base.saturating_add(per.saturating_mul(n as u64))
+    }
+
+    /// Give every step a work budget of `base + per_sphere × n` pair
+    /// checks instead of the default (`u64::MAX` for none).
+    #[must_use]
+    pub fn with_work_budget(mut self, base: u64, per_sphere: u64) -> Self {
+        self.budget = Some((base, per_sphere));
+        self
+    }
+
+    /// One part of a step (see `parts.rs`), with `left` work of the step's
+    /// budget, which it takes what it used from.
+    fn step(&mut self, world: &mut World, dt: f64, exec: &dyn Exec, left: &mut u64) -> PartEnd {
         let size = world.size;
-        let ready = self
-            .ahead
-            .take()
-            .is_some_and(|a| a.dt == dt && a.key == WorldKey::of(world));
-        if !ready {
-            self.detect(world, dt, exec);
+        let ready = self.ahead.take().filter(|a| {
+            a.dt == dt && a.key == WorldKey::of(world) && (a.overran || self.pairs_fit(*left))
+        });
+        let overran = if let Some(a) = ready {
+            a.overran
+        } else {
+            self.detect(world, dt, exec, *left);
+            self.detect.overran
+        };
+        if overran {
+            return PartEnd::Overran;
         }
+        *left -= self.detect.pairs.len() as u64;
         self.rounds.run(
             exec,
             &world.spheres,
@@ -204,7 +264,9 @@ impl Swept {
             &self.meets,
             &self.near,
             &self.hits,
+            *left,
         );
+        *left = left.saturating_sub(self.rounds.work);
         // Everyone flies straight; then the spheres with events take their
         // run's end, and the counters are summed in sphere order: the same
         // bits on any lanes and however the clusters fell.
@@ -214,20 +276,27 @@ impl Swept {
             }
         });
         let c = &mut world.counters;
-        let mut capped = false;
+        let mut capped = None;
         for (m, cap) in self.rounds.results() {
             world.spheres[m.id as usize] = m.sphere;
             c.wall_momentum += m.wall_momentum;
             c.sphere_collisions += u64::from(m.pair_hits);
             c.wall_collisions += u64::from(m.wall_hits);
-            capped |= cap;
+            capped = capped.max(cap);
         }
-        capped
+        PartEnd::Ran(capped)
+    }
+
+    /// Whether the pairs of the detection last made fit in `left` work.
+    fn pairs_fit(&self, left: u64) -> bool {
+        self.detect.pairs.len() as u64 <= left
     }
 
     /// Finds the pairs and walls of a step of `dt` from `world`; returns the
     /// deepest overlap among the pairs (relative to the smaller radius).
-    fn detect(&mut self, world: &World, dt: f64, exec: &dyn Exec) -> f64 {
+    /// Finding more than `limit` pairs stops it (`self.detect.overran`).
+    fn detect(&mut self, world: &World, dt: f64, exec: &dyn Exec, limit: u64) -> f64 {
+        self.detect.pair_limit = Some(usize::try_from(limit).unwrap_or(usize::MAX));
         let size = world.size;
         let sp = &world.spheres;
         let ball = |s: &Sphere| path_ball(s, dt);
@@ -243,12 +312,18 @@ impl Swept {
             self.detect
                 .run(exec, sp, size, ball, &|_, _| true, &|_| false);
             self.hits.clear();
+            if self.detect.overran {
+                return 0.0;
+            }
             let hits = &mut self.hits;
             self.detect.grid.near_faces(&mut |i| {
                 if reaches_wall(&sp[i as usize], size, dt) {
                     hits.push(i);
                 }
             });
+        }
+        if self.detect.overran {
+            return 0.0;
         }
         self.sort_pairs(sp, dt, exec)
     }
@@ -299,6 +374,18 @@ impl Swept {
         self.overlap[..blocks]
             .iter()
             .fold(0.0, |worst, d| worst.max(*d.lock()))
+    }
+}
+
+/// Every sphere flies `t` with wall bounces only (how a step out of budget
+/// ends): energy is kept and nobody leaves the box. Counters summed in
+/// sphere order, so the same bits on any lanes.
+fn fly_all(world: &mut World, t: f64) {
+    let (size, c) = (world.size, &mut world.counters);
+    for s in &mut world.spheres {
+        let (momentum, hits) = fly(s, size, t);
+        c.wall_momentum += momentum;
+        c.wall_collisions += hits;
     }
 }
 

@@ -26,7 +26,7 @@
 //!
 //! Here: the rounds and the runs of each. The clusters themselves are in
 //! `partition.rs`, the path comparison and grown balls in `conflicts.rs`.
-use super::cluster::{Member, Run, Shared};
+use super::cluster::{Coarse, Member, Run, Shared};
 use super::conflicts::{Conflicts, Finished};
 use super::partition::{Batch, Partition, Slot};
 use crate::physics::broad::Grid;
@@ -49,8 +49,9 @@ const PERCOLATION: (usize, usize) = (3, 10);
 /// What one block of clusters left.
 #[derive(Default)]
 struct BlockOut {
-    /// Finished clusters: (capped, how many of `members` are theirs).
-    done: Vec<(bool, u32)>,
+    /// Finished clusters: (why capped, how many of `members` are theirs,
+    /// the work the run did).
+    done: Vec<(Option<Coarse>, u32, u64)>,
     members: Vec<Member>,
     /// The members' turns (`Member::turn0` indexes here).
     turns: Vec<super::cluster::Turn>,
@@ -107,6 +108,8 @@ pub(super) struct Rounds {
     in_order: Vec<Slot>,
     late: Vec<Slot>,
     pub stats: RoundStats,
+    /// Work (see `Run::work`) done by the last `run`'s cluster runs.
+    pub work: u64,
     /// Run every step as one absorbing cluster (the plain serial loop),
     /// whatever the lanes.
     pub serial_only: bool,
@@ -114,10 +117,10 @@ pub(super) struct Rounds {
 
 impl Rounds {
     /// The results of the last `run`: every sphere that had events, with
-    /// its run's end of the step and whether the run hit the event cap, in
-    /// sphere order (so totals summed in this order are the serial loop's
-    /// to the bit, however the clusters fell).
-    pub fn results(&self) -> impl Iterator<Item = (&Member, bool)> {
+    /// its run's end of the step and whether (and why) the run was capped,
+    /// in sphere order (so totals summed in this order are the serial
+    /// loop's to the bit, however the clusters fell).
+    pub fn results(&self) -> impl Iterator<Item = (&Member, Option<Coarse>)> {
         self.in_order.iter().map(|&s| {
             let s = s.index();
             let m = self.fin.out[s].as_ref();
@@ -132,6 +135,9 @@ impl Rounds {
     /// meet within `dt`, `near` pairs whose balls overlap but do not meet,
     /// `hits` the spheres that reach a wall. Each involved sphere's end of
     /// the step is then among [`Rounds::results`]; `spheres` is not changed.
+    /// The runs may do `budget` work in all, each round's split over its
+    /// runs by their members (so not by lanes); [`Rounds::work`] says how
+    /// much they did.
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &mut self,
@@ -143,7 +149,9 @@ impl Rounds {
         meets: &[(u32, u32)],
         near: &[(u32, u32)],
         hits: &[u32],
+        budget: u64,
     ) {
+        self.work = 0;
         let serial = self.start(spheres.len(), meets, near, hits);
         let mut round = 0;
         loop {
@@ -184,6 +192,9 @@ impl Rounds {
                 partners: &self.part.partners,
                 size,
                 dt,
+                // A round's runs start with at most every slot between them.
+                work_per_member: budget.saturating_sub(self.work)
+                    / self.part.ids.len().max(1) as u64,
             };
             self.run_clusters(lanes, &sh, absorb);
             self.collect();
@@ -300,7 +311,7 @@ impl Rounds {
                     }));
                     out.cross.extend_from_slice(&run.cross);
                     let len = (out.members.len() - before) as u32;
-                    out.done.push((run.capped, len));
+                    out.done.push((run.capped, len, run.work));
                 }
             }
         });
@@ -319,7 +330,8 @@ impl Rounds {
         for block in &outs[..self.batch.todo.len().div_ceil(CLUSTER_BLOCK)] {
             let out = block.lock();
             let mut k = 0usize;
-            for &(capped, len) in &out.done {
+            for &(capped, len, work) in &out.done {
+                self.work += work;
                 let members = &out.members[k..k + len as usize];
                 k += len as usize;
                 // Bystanders that joined a run are its members now.

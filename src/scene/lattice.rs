@@ -3,8 +3,8 @@
 //! lattice (up to packing π/6 ≈ 0.52 when N is a cube) with Gaussian
 //! velocities, then the dynamics melts the lattice within a few collisions
 //! per sphere.
-use super::Exact;
 use crate::error::BadInput;
+use crate::physics::exact::Exact;
 use crate::physics::{Model, Serial, Sphere, World};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};

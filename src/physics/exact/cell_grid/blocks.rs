@@ -6,7 +6,8 @@
 //! cell, which measured as the largest cost of a prediction. The rare
 //! spheres beyond [`BLOCK`] in one cell wait in a map from the cell, so a
 //! cell costs its 16-byte block and nothing more.
-use super::cell_list::NONE;
+use crate::physics::exact::NONE;
+use crate::physics::exact::renumber::apply;
 use std::collections::HashMap;
 
 /// Spheres a cell's block holds (cells are about a diameter wide, so most
@@ -14,7 +15,7 @@ use std::collections::HashMap;
 pub const BLOCK: usize = 3;
 
 #[derive(Clone, Debug, Default)]
-pub struct CellSlots {
+pub struct CellBlocks {
     /// Per cell: the first `BLOCK` spheres, then the count.
     blocks: Vec<[u32; BLOCK + 1]>,
     /// Spheres `BLOCK..count` of the cells holding more than `BLOCK`.
@@ -23,7 +24,7 @@ pub struct CellSlots {
     at: Vec<(u32, u32)>,
 }
 
-impl CellSlots {
+impl CellBlocks {
     /// `spheres` spheres, none in a cell, and `cells` empty cells.
     pub fn reset(&mut self, spheres: usize, cells: usize) {
         self.at.clear();
@@ -99,6 +100,23 @@ impl CellSlots {
         self.at[i] = (NONE, NONE);
     }
 
+    /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
+    /// every cell keeps its order.
+    pub fn relabel(&mut self, perm: &[u32], inv: &[u32]) {
+        for (old, &(c, k)) in self.at.iter().enumerate() {
+            if c == NONE {
+                continue;
+            }
+            let (k, new) = (k as usize, inv[old]);
+            if k < BLOCK {
+                self.blocks[c as usize][k] = new;
+            } else if let Some(o) = self.overflow.get_mut(&c) {
+                o[k - BLOCK] = new;
+            }
+        }
+        apply(&mut self.at, perm);
+    }
+
     #[inline]
     pub fn move_to(&mut self, i: usize, c: usize) {
         self.remove(i);
@@ -156,7 +174,7 @@ impl CellSlots {
     }
 }
 
-impl CellSlots {
+impl CellBlocks {
     /// [`Self::gather`] for a stencil of a fixed `K` cells (the 27 around a
     /// cell, the 9 a crossing brings), all within the grid: per cell one
     /// index, one 16-byte copy and two adds, no clamp. A count over `BLOCK` anywhere falls back to [`Self::gather`].
@@ -211,7 +229,7 @@ mod tests {
     fn matches_a_plain_list_per_cell() {
         let (spheres, cells) = (40, 6);
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
-        let mut s = CellSlots::default();
+        let mut s = CellBlocks::default();
         s.reset(spheres, cells);
         let mut reference: Vec<Vec<u32>> = vec![Vec::new(); cells];
         let mut out = Vec::new();
@@ -263,7 +281,7 @@ mod tests {
     fn stencil_gather_matches_the_general_one() {
         let (spheres, cells) = (120, 100);
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
-        let mut s = CellSlots::default();
+        let mut s = CellBlocks::default();
         s.reset(spheres, cells);
         for i in 0..spheres {
             // Crowd the low cells, so some hold more than BLOCK.

@@ -3,7 +3,7 @@
 //! bulk diameter, so spheres can only touch from neighbouring cells; a
 //! sphere's candidates are the spheres in the 27 cells around its own. A
 //! sphere changes cell only at a crossing event, so the pair bookkeeping is
-//! one move between cells ([`CellSlots`]), and crossings are rarer than
+//! one move between cells ([`CellBlocks`]), and crossings are rarer than
 //! neighbour-list rebuilds when the mean free path is long.
 //!
 //! Large spheres (the few far above the bulk radius) stay out of the grid:
@@ -11,13 +11,15 @@
 //! the cells over its own reach plus a skin, rescanning when it has moved
 //! the skin (a small sphere entering that reach does so by a crossing, which
 //! checks the large ones).
-use super::body::Body;
-use super::cell_list::{NONE, split_big, time_to_leave};
-use super::cell_slots::CellSlots;
-use super::schedule::{Event, Kind};
-use glam::DVec3;
+pub mod blocks;
 
-const BIG_FACTOR: f64 = 3.0;
+use super::NONE;
+use super::body::Body;
+use super::large::{BIG_FACTOR, split_big, time_to_leave};
+use super::renumber::apply;
+use super::schedule::{Event, Kind};
+use blocks::CellBlocks;
+use glam::DVec3;
 
 /// Most cells the grid may have per sphere, by default: in dilute scenes
 /// cells a diameter wide would number far more than the spheres, and an
@@ -28,7 +30,7 @@ const BIG_FACTOR: f64 = 3.0;
 pub const CELLS_PER_SPHERE: u32 = 4;
 
 #[derive(Clone, Debug, Default)]
-pub struct Cells {
+pub struct CellGrid {
     per_side: usize,
     /// Cells per side with a layer of always-empty cells around the grid,
     /// so the stencils below need no bounds checks (an unpredictable branch
@@ -45,7 +47,7 @@ pub struct Cells {
     coord: Vec<[u16; 3]>,
     cell: f64,
     /// The small spheres of each cell; large ones are in no cell.
-    list: CellSlots,
+    list: CellBlocks,
     bigs: Vec<u32>,
     /// Where each large sphere last scanned from (indexed like `bigs`).
     scan_centre: Vec<DVec3>,
@@ -54,7 +56,7 @@ pub struct Cells {
     skin: f64,
 }
 
-impl Cells {
+impl CellGrid {
     /// A grid of cells at least a diameter wide and at most `per_sphere`
     /// cells per sphere.
     pub fn build(&mut self, bodies: &[Body], size: f64, per_sphere: u32) {
@@ -192,6 +194,17 @@ impl Cells {
         let k = &mut self.coord[i][axis];
         *k = if up { *k + 1 } else { *k - 1 };
         self.list.move_to(i, to);
+    }
+
+    /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
+    /// every cell keeps its order.
+    pub fn relabel(&mut self, perm: &[u32], inv: &[u32]) {
+        self.list.relabel(perm, inv);
+        apply(&mut self.coord, perm);
+        apply(&mut self.big_slot, perm);
+        for b in &mut self.bigs {
+            *b = inv[*b as usize];
+        }
     }
 
     /// A large sphere rescans from where it is now.

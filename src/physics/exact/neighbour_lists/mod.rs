@@ -14,12 +14,15 @@
 //! few much larger spheres live on a second level — every small sphere checks
 //! them when it rebuilds, and a large one scans the grid cells over its own
 //! reach.
+pub mod chains;
+
+use super::NONE;
 use super::body::Body;
+use super::large::{BIG_FACTOR, split_big, time_to_leave};
+use super::renumber::{apply, apply_chunks};
+use chains::CellChains;
 use glam::DVec3;
 
-use super::cell_list::{CellList, NONE, split_big, time_to_leave};
-/// A sphere counts as large (second level) above this multiple of the bulk radius.
-const BIG_FACTOR: f64 = 3.0;
 /// Skin as a fraction of the bulk radius, at least: a quarter diameter
 /// (Smallenburg's 1.5 shell), best for dense scenes.
 const SKIN_MIN_RADII: f64 = 0.5;
@@ -157,6 +160,24 @@ impl Lists {
         }
     }
 
+    /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
+    /// every list keeps its order, so the `back` places hold.
+    fn relabel(&mut self, perm: &[u32], inv: &[u32]) {
+        apply_chunks(&mut self.flat, self.stride, perm);
+        apply(&mut self.len, perm);
+        apply(&mut self.slot, perm);
+        for i in 0..self.len.len() {
+            if self.slot[i] == NONE {
+                for l in self.of_mut(i) {
+                    l.j = inv[l.j as usize];
+                }
+            }
+        }
+        for l in self.big.iter_mut().flatten() {
+            l.j = inv[l.j as usize];
+        }
+    }
+
     fn grow(&mut self) {
         let old = self.stride;
         self.stride *= 2;
@@ -171,19 +192,19 @@ impl Lists {
 }
 
 #[derive(Clone, Debug, Default)]
-pub struct Neighbours {
+pub struct NeighbourLists {
     skin: f64,
     centre: Vec<Centre>,
     lists: Lists,
     per_side: usize,
     inv_cell: f64,
     /// The spheres of each cell, by centre; second-level ones are in none.
-    cells: CellList,
+    cells: CellChains,
     bigs: Vec<u32>,
     small_rmax: f64,
 }
 
-impl Neighbours {
+impl NeighbourLists {
     /// Bytes held on the heap.
     pub fn heap_bytes(&self) -> usize {
         let l = &self.lists;
@@ -251,6 +272,17 @@ impl Neighbours {
             self.cells.move_to(i, self.cell_index(bodies[i].pos));
         }
         self.scan(i, bodies, |j| j != i);
+    }
+
+    /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
+    /// every list and cell keeps its order.
+    pub fn relabel(&mut self, perm: &[u32], inv: &[u32]) {
+        apply(&mut self.centre, perm);
+        self.lists.relabel(perm, inv);
+        self.cells.relabel(perm, inv);
+        for b in &mut self.bigs {
+            *b = inv[*b as usize];
+        }
     }
 
     #[inline]
