@@ -121,8 +121,8 @@ pub(super) struct Turn {
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Member {
     pub id: u32,
-    /// Its slot among the spheres with events when the run began (`Slot::NONE` for
-    /// a bystander that joined the run).
+    /// Its slot among the spheres with events when the run began
+    /// (`Slot::NONE` for a bystander that joined the run).
     pub slot: Slot,
     pub sphere: Sphere,
     /// Momentum given to the walls, for the pressure.
