@@ -73,6 +73,24 @@ pub enum Coarse {
     Work,
 }
 
+/// A sphere's index among a run's members: what the run's tables are
+/// indexed with, never a sphere id or a slot.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Local(u32);
+
+impl Local {
+    /// Not a member (of the run, or the wall of a wall event).
+    const NONE: Local = Local(u32::MAX);
+
+    fn at(index: usize) -> Local {
+        Local(index as u32)
+    }
+
+    fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
 /// An event; `a`, `b` are sphere ids (`b` NONE for a wall), `la`, `lb` the
 /// run's local indices, `ca`, `cb` the collision counts it was predicted at.
 #[derive(Clone, Copy, Debug)]
@@ -80,8 +98,8 @@ struct Event {
     t: f64,
     a: u32,
     b: u32,
-    la: u32,
-    lb: u32,
+    la: Local,
+    lb: Local,
     ca: u32,
     cb: u32,
 }
@@ -146,9 +164,9 @@ pub(super) struct Member {
 pub(super) struct Run {
     ids: Vec<u32>,
     slots: Vec<Slot>,
-    /// Sphere id → local index for members, NONE for everyone else; kept
-    /// so between runs (one lookup per candidate, the hot path).
-    local_of: Vec<u32>,
+    /// Sphere id → local index for members, `Local::NONE` for everyone
+    /// else; kept so between runs (one lookup per candidate, the hot path).
+    local_of: Vec<Local>,
     sp: Vec<Sphere>,
     t_local: Vec<f64>,
     count: Vec<u32>,
@@ -190,7 +208,7 @@ impl Run {
         }
         self.events(sh, pairs, absorb);
         for &i in &self.ids {
-            self.local_of[i as usize] = NONE;
+            self.local_of[i as usize] = Local::NONE;
         }
         self.cross.sort_unstable();
         self.cross.dedup();
@@ -199,7 +217,7 @@ impl Run {
     fn events(&mut self, sh: &Shared, pairs: &[(u32, u32)], absorb: bool) {
         for &(i, j) in pairs {
             let (a, b) = (self.local_of[i as usize], self.local_of[j as usize]);
-            let (si, sj) = (&self.sp[a as usize], &self.sp[b as usize]);
+            let (si, sj) = (&self.sp[a.index()], &self.sp[b.index()]);
             if let Some(t) = pair_toi(si.pos - sj.pos, si.vel - sj.vel, si.radius + sj.radius) {
                 self.heap.push(pair_event(t, i, j, a, b, 0, 0));
             }
@@ -209,7 +227,7 @@ impl Run {
         self.work = pairs.len() as u64;
         let mut done = 0usize;
         while let Some(e) = self.heap.pop() {
-            let (la, lb) = (e.la as usize, e.lb as usize);
+            let (la, lb) = (e.la.index(), e.lb.index());
             if self.count[la] != e.ca || (e.b != NONE && self.count[lb] != e.cb) {
                 continue;
             }
@@ -320,7 +338,7 @@ impl Run {
 
     fn clear(&mut self, n: usize) {
         if self.local_of.len() < n {
-            self.local_of.resize(n, NONE);
+            self.local_of.resize(n, Local::NONE);
         }
         self.ids.clear();
         self.slots.clear();
@@ -346,15 +364,15 @@ impl Run {
     #[inline(always)]
     fn member(&self, j: u32) -> Option<usize> {
         match self.local_of[j as usize] {
-            NONE => None,
-            l => Some(l as usize),
+            Local::NONE => None,
+            l => Some(l.index()),
         }
     }
 
     /// Adds sphere `i` (at the start of the step) to the run; returns its
     /// local index.
-    fn involve(&mut self, sh: &Shared, i: u32) -> u32 {
-        let l = self.ids.len() as u32;
+    fn involve(&mut self, sh: &Shared, i: u32) -> Local {
+        let l = Local::at(self.ids.len());
         let s = sh.spheres[i as usize];
         self.local_of[i as usize] = l;
         self.ids.push(i);
@@ -399,7 +417,16 @@ impl Run {
             self.reach[la] = need;
         }
         let ca = self.count[la];
-        push_wall(&mut self.heap, &sa, ia, la as u32, t, ca, sh.size, sh.dt);
+        push_wall(
+            &mut self.heap,
+            &sa,
+            ia,
+            Local::at(la),
+            t,
+            ca,
+            sh.size,
+            sh.dt,
+        );
         let mut found = std::mem::take(&mut self.found);
         found.clear();
         // Only what is left of the path can meet anyone: the ball around
@@ -501,18 +528,18 @@ impl Run {
             // A bystander that a member meets joins the run; if it joined
             // another run too, the caller sees it joined twice.
             let lb = match l {
-                Some(l) => l as u32,
+                Some(l) => Local::at(l),
                 None => self.involve(sh, j),
             };
-            let cb = self.count[lb as usize];
+            let cb = self.count[lb.index()];
             self.heap
-                .push(pair_event(t + dtc, ia, j, la as u32, lb, ca, cb));
+                .push(pair_event(t + dtc, ia, j, Local::at(la), lb, ca, cb));
         }
         self.found = found;
     }
 }
 
-fn pair_event(t: f64, a: u32, b: u32, la: u32, lb: u32, ca: u32, cb: u32) -> Event {
+fn pair_event(t: f64, a: u32, b: u32, la: Local, lb: Local, ca: u32, cb: u32) -> Event {
     if a < b {
         Event {
             t,
@@ -541,7 +568,7 @@ fn push_wall(
     heap: &mut BinaryHeap<Event>,
     s: &Sphere,
     a: u32,
-    la: u32,
+    la: Local,
     t: f64,
     ca: u32,
     size: f64,
@@ -554,7 +581,7 @@ fn push_wall(
             a,
             b: NONE,
             la,
-            lb: NONE,
+            lb: Local::NONE,
             ca,
             cb: 0,
         });
