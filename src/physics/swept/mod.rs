@@ -398,14 +398,3 @@ fn reaches_wall(s: &Sphere, size: f64, dt: f64) -> bool {
     // `|`, not `||`: one well-predicted branch instead of four.
     (end.min(s.pos).min_element() <= lo) | (end.max(s.pos).max_element() >= hi)
 }
-
-/// Still used by `discrete.rs` (being moved to `get_disjoint_mut`).
-pub(crate) fn pair_mut<T>(v: &mut [T], i: usize, j: usize) -> (&mut T, &mut T) {
-    if i < j {
-        let (lo, hi) = v.split_at_mut(j);
-        (&mut lo[i], &mut hi[0])
-    } else {
-        let (lo, hi) = v.split_at_mut(i);
-        (&mut hi[0], &mut lo[j])
-    }
-}
