@@ -503,20 +503,17 @@ impl Run {
                 self.cross.push((ia, j));
                 continue;
             }
-            let s = match l {
-                Some(l) => {
-                    let s = &self.sp[l];
-                    Sphere {
-                        pos: s.pos + s.vel * (t - self.t_local[l]),
-                        ..*s
-                    }
+            let s = if let Some(l) = l {
+                let s = &self.sp[l];
+                Sphere {
+                    pos: s.pos + s.vel * (t - self.t_local[l]),
+                    ..*s
                 }
-                None => {
-                    let s = &sh.spheres[j as usize];
-                    Sphere {
-                        pos: s.pos + s.vel * t,
-                        ..*s
-                    }
+            } else {
+                let s = &sh.spheres[j as usize];
+                Sphere {
+                    pos: s.pos + s.vel * t,
+                    ..*s
                 }
             };
             let Some(dtc) = pair_toi(sa.pos - s.pos, sa.vel - s.vel, sa.radius + s.radius) else {

@@ -123,11 +123,10 @@ impl Rounds {
     pub fn results(&self) -> impl Iterator<Item = (&Member, Option<Coarse>)> {
         self.in_order.iter().map(|&s| {
             let s = s.index();
-            let m = self.fin.out[s].as_ref();
-            (
-                m.expect("every involved sphere finished"),
-                self.fin.capped[s],
-            )
+            let Some(m) = self.fin.out[s].as_ref() else {
+                unreachable!("every involved sphere finished");
+            };
+            (m, self.fin.capped[s])
         })
     }
 
