@@ -9,7 +9,6 @@ use super::detect::{Detection, SPHERE_BLOCK};
 use super::exec::{Exec, for_each_chunk};
 use super::model::{Model, ModelKind};
 use super::sphere::Sphere;
-use super::swept::pair_mut;
 use super::world::World;
 
 #[derive(Default)]
@@ -61,7 +60,9 @@ impl Discrete {
             world.counters.wall_collisions += hits;
         }
         for &(i, j) in &self.detect.pairs {
-            let (a, b) = pair_mut(&mut world.spheres, i as usize, j as usize);
+            let Ok([a, b]) = world.spheres.get_disjoint_mut([i as usize, j as usize]) else {
+                unreachable!("detection pairs two distinct spheres, got ({i}, {j})");
+            };
             if resolve_pair(a, b) {
                 world.counters.sphere_collisions += 1;
             }
