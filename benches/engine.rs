@@ -251,14 +251,14 @@ impl Render {
             self.canvas.fill(b' ');
             let tilt = pass as f64 * 1e-3;
             for v in &snap.spheres {
-                let [x, y, z] = v.pos.map(|q| q - 0.5 * snap.size);
+                let [x, y, z] = v.pos.map(|q| f64::from(q) - 0.5 * snap.size);
                 let (x, z) = (c * x + s * z, -s * x + c * z);
                 let (y, z) = (y * (1.0 - tilt) + z * tilt, z);
                 let k = 1.5 / (2.5 + z);
                 let px = ((x * k + 0.5) * Self::W as f64) as isize;
                 let py = ((y * k + 0.5) * Self::H as f64) as isize;
                 if (0..Self::W as isize).contains(&px) && (0..Self::H as isize).contains(&py) {
-                    let shade = (v.speed * 8.0).min(7.0) as u8;
+                    let shade = (f64::from(v.speed) * 8.0).min(7.0) as u8;
                     self.canvas[py as usize * Self::W + px as usize] = b'0' + shade;
                 }
             }

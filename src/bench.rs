@@ -87,7 +87,8 @@ pub fn warnings(report: &BenchReport) -> Vec<String> {
 /// Run `steps` steps through the engine in frames of `settings.tick` steps
 /// (the last one shorter), in the settings' threading mode; returns the
 /// report and the final world (for `--dump`). `wall_seconds` counts only
-/// the stepping, not the snapshots between frames.
+/// the stepping, not the snapshots between frames. The engine is headless
+/// and the final world is moved out of it, so the spheres are held once.
 pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(BenchReport, World)> {
     let e0 = world.kinetic_energy();
     let rel = |e: f64| {
@@ -99,7 +100,7 @@ pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(Ben
     };
     let t_start = world.time;
     let frame = u64::from(settings.tick.max(1));
-    let mut engine = Engine::new(
+    let mut engine = Engine::headless(
         world,
         Settings {
             tick: settings.tick.max(1),
@@ -133,14 +134,18 @@ pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(Ben
     let physics_threads = engine.physics_threads();
     let physics_cpu_seconds = physics_cpu(&engine, &physics_threads, &cpu_before);
     let load_end = load_average();
-    let world = engine.world().clone();
     // Read while the engine's threads are still alive.
     let thread_cpu = crate::cpu::thread_cpu_seconds()
         .into_iter()
         .map(|(name, cpu_seconds)| ThreadCpu { name, cpu_seconds })
         .collect();
-    drop(engine);
-    let e1 = world.kinetic_energy();
+    // The last snapshot's figures are the final world's (the overlap is
+    // `World::max_overlap_rel`'s, found without building another grid).
+    let last = engine.snapshot();
+    let (e1, escaped, max_overlap_rel) = (last.energy, last.escaped, last.max_overlap_rel);
+    let world = engine
+        .into_world()
+        .ok_or_else(|| anyhow::anyhow!("the engine lost its world"))?;
     let sim = world.time - t_start;
     let n = world.spheres.len();
     let per_sec = |x: f64| if wall > 0.0 { x / wall } else { 0.0 };
@@ -163,8 +168,8 @@ pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(Ben
         energy_end: e1,
         energy_drift_rel: rel(e1),
         max_energy_err_rel: max_err.max(rel(e1)),
-        escaped: world.escaped(),
-        max_overlap_rel: world.max_overlap_rel(),
+        escaped,
+        max_overlap_rel,
         sphere_collisions: c.sphere_collisions,
         wall_collisions: c.wall_collisions,
         wall_pressure: if sim > 0.0 {

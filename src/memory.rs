@@ -3,15 +3,22 @@
 //! kernel's OOM killer.
 use crate::physics::ModelKind;
 
-/// Peak bytes a sphere costs while a model steps, with a quarter for margin
-/// (peak RSS at a million spheres; docs/benchmarks.md has the runs).
+/// Peak bytes a sphere costs while a model steps headless (`bench`), with a
+/// quarter for margin (peak RSS at a million spheres less the empty process,
+/// packing 0.005 and 0.1, the larger; docs/benchmarks.md has the runs).
 pub fn sphere_bytes(model: ModelKind) -> u64 {
     match model {
-        ModelKind::Discrete => 650,
-        ModelKind::Swept => 550,
-        ModelKind::Exact => 800,
+        ModelKind::Discrete => 380,
+        ModelKind::Swept => 420,
+        ModelKind::Exact => 510,
     }
 }
+
+/// What the app holds a sphere on top of the model's run, with the same
+/// margin: the start kept for Reset (64 bytes; only for a scene from a
+/// file, a preset is made again) and the front and back screen views (20
+/// bytes each).
+const SCREEN_BYTES: u64 = 130;
 
 /// What the process takes before any sphere: code, threads, buffers.
 const BASE_BYTES: u64 = 64 << 20;
@@ -19,8 +26,9 @@ const BASE_BYTES: u64 = 64 << 20;
 /// The share of the memory the machine has free that a run may plan on.
 const SHARE: f64 = 0.5;
 
-/// Bytes a world of `count` spheres needs under `model`, or under whichever
-/// model needs most (`None`: the app can switch models at any time).
+/// Bytes a world of `count` spheres needs headless under `model`, or in the
+/// app (`None`): under whichever model needs most, since the app can switch
+/// at any time, plus what the screen keeps.
 pub fn need(count: usize, model: Option<ModelKind>) -> u64 {
     let per = model.map_or_else(
         || {
@@ -29,6 +37,7 @@ pub fn need(count: usize, model: Option<ModelKind>) -> u64 {
                 .into_iter()
                 .max()
                 .unwrap_or(0)
+                + SCREEN_BYTES
         },
         sphere_bytes,
     );
@@ -74,6 +83,17 @@ pub fn check(count: usize, model: Option<ModelKind>, free: Option<u64>) -> Resul
     ))
 }
 
+/// What `count` spheres would take and what the machine has, for a message
+/// that refuses them for another reason (e.g. more than ballpit supports).
+pub fn need_text(count: usize, model: Option<ModelKind>) -> String {
+    let with = model.map_or(String::new(), |m| format!(" with {m}"));
+    let have = available().map_or(String::new(), |f| format!("; {} is available", mib(f)));
+    format!(
+        "they would need about {} of memory{with}{have}",
+        mib(need(count, model))
+    )
+}
+
 fn mib(bytes: u64) -> String {
     if bytes >= 10 << 30 {
         format!("{} GiB", bytes >> 30)
@@ -100,15 +120,18 @@ mod tests {
         assert!(check(1_000_000, Some(ModelKind::Swept), free).is_ok());
         let err = check(10_000_000, Some(ModelKind::Exact), free).unwrap_err();
         assert!(
-            err.starts_with("10000000 spheres would need about 7693 MiB"),
+            err.starts_with("10000000 spheres would need about 4927 MiB"),
             "{err}"
         );
         assert!(
             err.contains("with exact") && err.contains("4096 MiB"),
             "{err}"
         );
-        // Unknown model: the hungriest one counts.
-        assert_eq!(need(1000, None), need(1000, Some(ModelKind::Exact)));
+        // The app: the hungriest model counts, and the screen's copies.
+        assert_eq!(
+            need(1000, None),
+            need(1000, Some(ModelKind::Exact)) + 1000 * SCREEN_BYTES
+        );
         // No figure from the system: nothing to check against.
         assert!(check(usize::MAX, None, None).is_ok());
         assert_eq!(need(usize::MAX, None), u64::MAX);

@@ -70,7 +70,7 @@ fn check(balls: &[((f64, f64, f64), f64)]) -> Result<(), TestCaseError> {
     // `near` finds every sphere whose ball meets a query ball.
     for (k, a) in spheres.iter().enumerate().step_by(7) {
         let mut seen = BTreeSet::new();
-        grid.near(a.pos, a.radius, &mut |j, _, _| {
+        grid.near(a.pos, a.radius, 1.0, &mut |j, _, _| {
             seen.insert(j as usize);
         });
         for (j, b) in spheres.iter().enumerate() {

@@ -508,3 +508,25 @@ fn snapshots_carry_the_parts_of_the_last_step() {
     e.start_frame().unwrap();
     assert_eq!(e.finish_frame().unwrap().parts, 1);
 }
+
+#[test]
+fn a_threaded_frame_says_when_it_is_done() {
+    let world = scene(500, 0.01, 0.1, 0, 0.3, 4);
+    for threading in [Threading::Worker, Threading::Pool, Threading::Split] {
+        let mut e =
+            Engine::new(world.clone(), settings(ModelKind::Swept, threading, 2, 3)).unwrap();
+        let (tx, rx) = crossbeam_channel::unbounded();
+        e.set_notify(Box::new(move || {
+            let _ = tx.send(());
+        }));
+        for _ in 0..3 {
+            e.start_frame().unwrap();
+            // Awaited, not polled: the notice comes once the frame is back.
+            rx.recv_timeout(Duration::from_secs(20)).unwrap();
+            assert!(e.frame_ready(), "{threading}");
+            e.finish_frame().unwrap();
+        }
+        assert!(rx.try_recv().is_err(), "one notice a frame");
+        check_invariants(&world, e.world(), 1e-9);
+    }
+}

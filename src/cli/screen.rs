@@ -1,8 +1,9 @@
 //! The terminal app as the command line opens it: shared by `main` and the
 //! examples that must start it the same way (`examples/panic_probe.rs`).
 use super::Cli;
+use crate::engine::Rebuild;
 use crate::error::BadInput;
-use crate::tui::AfterFirstFrame;
+use crate::tui::{AfterFirstFrame, RunExtras};
 use crate::{memory, scene, tui};
 use std::io::IsTerminal;
 
@@ -21,9 +22,25 @@ impl Cli {
             )
             .into());
         }
-        let world = scene::build_world_for(&self.scene.spec(), Some(settings.model))?;
+        let spec = self.scene.spec();
+        let world = scene::build_world_for(&spec, Some(settings.model))?;
         // The app can switch to any model: plan for the hungriest.
         memory::check(world.spheres.len(), None, memory::available()).map_err(BadInput)?;
-        tui::run_with(world, settings, opts, after_first_frame)
+        // A preset is made again for Reset rather than kept; a file's
+        // spheres are kept (the file may change meanwhile).
+        let from_file = spec.scene.as_deref().is_some_and(|s| {
+            std::path::Path::new(s)
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("csv") || e.eq_ignore_ascii_case("toml"))
+        });
+        let rebuild = (!from_file).then(|| {
+            let model = settings.model;
+            Box::new(move || Ok(scene::build_world_for(&spec, Some(model))?)) as Rebuild
+        });
+        let extras = RunExtras {
+            rebuild,
+            after_first_frame,
+        };
+        tui::run_with(world, settings, opts, extras)
     }
 }

@@ -19,13 +19,21 @@ pub(crate) struct Frame {
     pub notice: Option<String>,
     /// The back buffer: filled here, swapped to the front when done.
     pub snap: Snapshot,
+    /// Whether the snapshot carries the spheres (a headless run needs none).
+    pub views: bool,
     scratch: OverlapScratch,
 }
 
 impl Frame {
-    pub fn new(world: World, model: Box<dyn Model>, exec: SharedExec, settings: Settings) -> Frame {
+    pub fn new(
+        world: World,
+        model: Box<dyn Model>,
+        exec: SharedExec,
+        settings: Settings,
+        views: bool,
+    ) -> Frame {
         let energy_reset = world.kinetic_energy();
-        let snap = Snapshot::new(&world, settings, energy_reset);
+        let snap = Snapshot::new(&world, settings, energy_reset, views);
         Frame {
             world,
             model,
@@ -35,6 +43,7 @@ impl Frame {
             number: 0,
             notice: None,
             snap,
+            views,
             scratch: OverlapScratch::default(),
         }
     }
@@ -63,7 +72,13 @@ impl Frame {
         let physics_seconds = t0.elapsed().as_secs_f64();
         self.number += 1;
         let snap = &mut self.snap;
-        snap.fill_world(&self.world, self.model.last_parts(), overlap, &*self.exec);
+        snap.fill_world(
+            &self.world,
+            self.model.last_parts(),
+            overlap,
+            &*self.exec,
+            self.views,
+        );
         snap.frame = self.number;
         snap.energy_reset = self.energy_reset;
         snap.physics_seconds = physics_seconds;

@@ -17,17 +17,21 @@
 mod frame;
 mod pool;
 mod snapshot;
+mod start;
 mod worker;
 
 pub use pool::{PoolExec, SPLIT_NAMES, SplitExec};
 pub use snapshot::{Snapshot, SphereView};
+pub use start::Rebuild;
 
 use crate::physics::{Model, ModelKind, Serial, World, edit};
 use frame::{Frame, SharedExec};
 use rand::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
+use start::Start;
 use std::sync::Arc;
 use strum::{Display, EnumCount, EnumString, IntoStaticStr};
+pub use worker::Notify;
 use worker::Worker;
 
 /// Where the physics runs (docs/design.md, Threading); the names are the
@@ -141,7 +145,12 @@ pub struct Engine {
     home: Option<Box<Frame>>,
     in_flight: bool,
     front: Snapshot,
-    initial: World,
+    /// The scene as it started, for Reset.
+    start: Start,
+    /// The start's median radius and rms speed, for spheres added to an
+    /// emptied box.
+    start_radius: Option<f64>,
+    start_speed: f64,
     settings: Settings,
     pending: Vec<Command>,
     worker: Worker,
@@ -161,17 +170,58 @@ impl Engine {
     /// An engine running a model of the caller's (tests, instrumented runs).
     pub fn with_model(
         world: World,
+        settings: Settings,
+        model: Box<dyn Model>,
+    ) -> anyhow::Result<Engine> {
+        let start = Start::Kept(world.clone());
+        Engine::build(world, settings, model, start, true)
+    }
+
+    /// An engine that rebuilds the start on Reset instead of keeping a copy
+    /// (a preset scene: `rebuild` must give the same world each time; Reset
+    /// checks, and leaves a notice if not).
+    ///
+    /// # Errors
+    /// When the `physics` thread cannot be started.
+    pub fn with_rebuild(
+        world: World,
+        settings: Settings,
+        rebuild: Rebuild,
+    ) -> anyhow::Result<Engine> {
+        let model = settings.model.build();
+        let start = Start::rebuilt(&world, rebuild);
+        Engine::build(world, settings, model, start, true)
+    }
+
+    /// An engine for runs without a screen (`bench`): its snapshots carry
+    /// the figures but not the spheres, and it keeps no copy of the start,
+    /// so Reset only leaves a notice. The world is then held once.
+    ///
+    /// # Errors
+    /// When the `physics` thread cannot be started.
+    pub fn headless(world: World, settings: Settings) -> anyhow::Result<Engine> {
+        let model = settings.model.build();
+        Engine::build(world, settings, model, Start::Dropped, false)
+    }
+
+    fn build(
+        world: World,
         mut settings: Settings,
         model: Box<dyn Model>,
+        start: Start,
+        views: bool,
     ) -> anyhow::Result<Engine> {
         settings.threads = settings.threads.clamp(1, MAX_THREADS);
         let serial: SharedExec = Arc::new(Serial);
-        let frame = Frame::new(world.clone(), model, serial.clone(), settings);
+        let (start_radius, start_speed) = (edit::typical_radius(&world), edit::rms_speed(&world));
+        let frame = Frame::new(world, model, serial.clone(), settings, views);
         Ok(Engine {
             front: frame.snap.clone(),
             home: Some(Box::new(frame)),
             in_flight: false,
-            initial: world,
+            start,
+            start_radius,
+            start_speed,
             settings,
             pending: Vec::new(),
             worker: Worker::spawn()?,
@@ -255,10 +305,23 @@ impl Engine {
         self.home.as_ref().map(|f| &f.world)
     }
 
+    /// The world, moved out without a copy (as `try_world`: `None` while a
+    /// frame is in flight or after the physics failed).
+    #[must_use]
+    pub fn into_world(mut self) -> Option<World> {
+        self.home.take().map(|f| f.world)
+    }
+
     /// Whether `finish_frame` would return without waiting: no frame is in
     /// flight, or the one in flight is done.
     pub fn frame_ready(&self) -> bool {
         !self.in_flight || self.worker.ready()
+    }
+
+    /// Call `f` (on the `physics` thread) whenever a threaded frame is done,
+    /// so a caller waiting on something else can collect it at once.
+    pub fn set_notify(&self, f: Notify) {
+        self.worker.set_notify(f);
     }
 
     /// Whether a threaded frame is being computed.
@@ -331,14 +394,13 @@ impl Engine {
                         continue;
                     }
                     let w = &mut frame.world;
-                    let radius = edit::typical_radius(w)
-                        .or_else(|| edit::typical_radius(&self.initial))
-                        .unwrap_or(0.02 * w.size);
-                    let speed = if w.spheres.is_empty() {
-                        edit::rms_speed(&self.initial)
+                    // An emptied box takes new spheres like the start's.
+                    let (radius, speed) = if w.spheres.is_empty() {
+                        (self.start_radius, self.start_speed)
                     } else {
-                        edit::rms_speed(w)
+                        (edit::typical_radius(w), edit::rms_speed(w))
                     };
+                    let radius = radius.unwrap_or(0.02 * w.size);
                     frame.notice = edit::set_count(w, n, radius, speed, &mut self.rng);
                     self.edited(frame);
                 }
@@ -347,7 +409,13 @@ impl Engine {
                     self.edited(frame);
                 }
                 Command::Reset => {
-                    frame.world = self.initial.clone();
+                    match self.start.world() {
+                        Ok(w) => frame.world = w,
+                        Err(why) => {
+                            frame.notice = Some(why);
+                            continue;
+                        }
+                    }
                     frame.world.touch();
                     frame.model = self.settings.model.build();
                     frame.notice = None;

@@ -2,20 +2,22 @@
 //! one the renderer reads while the physics fills the back one.
 use super::Settings;
 use crate::physics::broad::{Grid, Pair};
-use crate::physics::exec::for_each_chunk;
+use crate::physics::exec::{for_each_block, for_each_chunk};
 use crate::physics::world::escapes;
 use crate::physics::{Counters, Exec, World};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 
 /// Spheres per parallel block when copying them out.
 const VIEW_BLOCK: usize = 8192;
 
-/// What the screen needs of one sphere.
+/// What the screen needs of one sphere. Single precision: a screen is a few
+/// thousand pixels across, f32 resolves a millionth of the box (20 bytes a
+/// sphere instead of 40, and two snapshots hold them).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SphereView {
-    pub pos: [f64; 3],
-    pub radius: f64,
-    pub speed: f64,
+    pub pos: [f32; 3],
+    pub radius: f32,
+    pub speed: f32,
 }
 
 /// One finished frame, read by the renderer while the next one computes.
@@ -24,7 +26,12 @@ pub struct Snapshot {
     pub frame: u64,
     pub time: f64,
     pub size: f64,
+    /// Empty in a headless engine (`Engine::headless`): read `count`.
     pub spheres: Vec<SphereView>,
+    /// Spheres in the world.
+    pub count: usize,
+    /// The largest radius, exactly (`None` for an empty box).
+    pub max_radius: Option<f64>,
     pub energy: f64,
     /// Energy right after the last reset (or scene start), for the drift.
     pub energy_reset: f64,
@@ -46,12 +53,19 @@ pub struct Snapshot {
 }
 
 impl Snapshot {
-    pub(crate) fn new(world: &World, settings: Settings, energy_reset: f64) -> Snapshot {
+    pub(crate) fn new(
+        world: &World,
+        settings: Settings,
+        energy_reset: f64,
+        views: bool,
+    ) -> Snapshot {
         let mut s = Snapshot {
             frame: 0,
             time: 0.0,
             size: world.size,
             spheres: Vec::new(),
+            count: 0,
+            max_radius: None,
             energy: 0.0,
             energy_reset,
             max_overlap_rel: 0.0,
@@ -65,40 +79,61 @@ impl Snapshot {
         };
         let serial = crate::physics::Serial;
         let overlap = OverlapScratch::default().max_overlap_rel(world, &serial);
-        s.fill_world(world, 1, overlap, &serial);
+        s.fill_world(world, 1, overlap, &serial, views);
         s
     }
 
-    /// Copy what the screen needs out of `world`, reusing the buffers; the
-    /// parts and the overlap come from the frame's timed work.
+    /// Copy what the screen needs out of `world` (the sphere views only if
+    /// `views`), reusing the buffers; the parts and the overlap come from
+    /// the frame's timed work.
     pub(crate) fn fill_world(
         &mut self,
         world: &World,
         parts: u32,
         max_overlap_rel: f64,
         exec: &dyn Exec,
+        views: bool,
     ) {
         self.time = world.time;
         self.size = world.size;
-        // The copy and the escape count run on the frame's executor: at
-        // 100 000 spheres they would otherwise be a serial tail on every
-        // frame of a parallel mode.
+        // The copy and the scans run on the frame's executor: at 100 000
+        // spheres they would otherwise be a serial tail on every frame of a
+        // parallel mode.
         let sp = &world.spheres;
-        self.spheres.resize(sp.len(), SphereView::default());
         let escaped = AtomicUsize::new(0);
+        // Radii are positive, so their bits order like the numbers.
+        let widest = AtomicU64::new(0);
         let tol = 1e-9 * world.size;
-        for_each_chunk(exec, &mut self.spheres, VIEW_BLOCK, &|b, chunk| {
-            let mut out = 0;
-            for (v, s) in chunk.iter_mut().zip(&sp[b * VIEW_BLOCK..]) {
-                *v = SphereView {
-                    pos: s.pos.to_array(),
-                    radius: s.radius,
-                    speed: s.vel.length(),
-                };
-                out += usize::from(escapes(s, world.size, tol));
+        let scan = |b: usize, out: Option<&mut [SphereView]>| {
+            let block = &sp[b * VIEW_BLOCK..sp.len().min((b + 1) * VIEW_BLOCK)];
+            let (mut n, mut r) = (0, 0.0f64);
+            for s in block {
+                n += usize::from(escapes(s, world.size, tol));
+                r = r.max(s.radius);
             }
-            escaped.fetch_add(out, Ordering::Relaxed);
-        });
+            if let Some(out) = out {
+                for (v, s) in out.iter_mut().zip(block) {
+                    *v = SphereView {
+                        pos: s.pos.as_vec3().to_array(),
+                        radius: s.radius as f32,
+                        speed: s.vel.length() as f32,
+                    };
+                }
+            }
+            escaped.fetch_add(n, Ordering::Relaxed);
+            widest.fetch_max(r.to_bits(), Ordering::Relaxed);
+        };
+        if views {
+            self.spheres.resize(sp.len(), SphereView::default());
+            for_each_chunk(exec, &mut self.spheres, VIEW_BLOCK, &|b, c| {
+                scan(b, Some(c));
+            });
+        } else {
+            self.spheres = Vec::new();
+            for_each_block(exec, sp.len().div_ceil(VIEW_BLOCK), &|b| scan(b, None));
+        }
+        self.count = sp.len();
+        self.max_radius = (!sp.is_empty()).then(|| f64::from_bits(widest.into_inner()));
         self.energy = world.kinetic_energy();
         self.parts = parts;
         self.max_overlap_rel = max_overlap_rel;

@@ -3,17 +3,23 @@
 //! (the article's start and done events, carrying the frame with them).
 use super::frame::Frame;
 use crossbeam_channel::{Receiver, Sender, bounded};
+use parking_lot::Mutex;
 use std::any::Any;
 use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::Arc;
 use std::thread::JoinHandle;
 
 pub(crate) type Outcome = Result<Box<Frame>, String>;
+
+/// Called on the `physics` thread each time a frame is back.
+pub type Notify = Box<dyn Fn() + Send>;
 
 pub(crate) struct Worker {
     start: Option<Sender<Box<Frame>>>,
     done: Receiver<Outcome>,
     handle: Option<JoinHandle<()>>,
     tid: Option<i32>,
+    notify: Arc<Mutex<Option<Notify>>>,
 }
 
 impl Worker {
@@ -21,6 +27,8 @@ impl Worker {
         let (start_tx, start_rx) = bounded::<Box<Frame>>(1);
         let (done_tx, done_rx) = bounded::<Outcome>(1);
         let (tid_tx, tid_rx) = bounded(1);
+        let notify: Arc<Mutex<Option<Notify>>> = Arc::default();
+        let hook = notify.clone();
         let handle = std::thread::Builder::new()
             .name("physics".into())
             .spawn(move || {
@@ -28,6 +36,9 @@ impl Worker {
                 while let Ok(frame) = start_rx.recv() {
                     if done_tx.send(run_caught(frame)).is_err() {
                         break;
+                    }
+                    if let Some(f) = &*hook.lock() {
+                        f();
                     }
                 }
             })?;
@@ -37,7 +48,13 @@ impl Worker {
             done: done_rx,
             handle: Some(handle),
             tid,
+            notify,
         })
+    }
+
+    /// Call `f` on the `physics` thread whenever a frame is back.
+    pub fn set_notify(&self, f: Notify) {
+        *self.notify.lock() = Some(f);
     }
 
     /// The thread's kernel id (Linux), to read its CPU time.

@@ -166,7 +166,10 @@ pub fn build_world_for(spec: &SceneSpec, model: Option<ModelKind>) -> Result<Wor
     );
     let count = merged.count.unwrap_or(preset.count);
     if count > MAX_COUNT {
-        return bad!("{count_label} {count} is more than the {MAX_COUNT} spheres ballpit supports");
+        return bad!(
+            "{count_label} {count} is more than the {MAX_COUNT} spheres ballpit supports ({})",
+            crate::memory::need_text(count, model)
+        );
     }
     let radius = match (merged.radius, preset.packing) {
         (Some(r), _) => r,

@@ -1,7 +1,7 @@
-//! The picture: spheres as filled discs (points when smaller than a pixel),
-//! drawn back to front over a depth buffer, and the cube's wireframe tested
-//! against that depth so edges hide behind near spheres.
-use super::projection::{Camera, Projected, Projection};
+//! The picture: spheres as filled discs (points when smaller than a pixel)
+//! over a depth buffer that keeps the nearest at each pixel, and the cube's
+//! wireframe tested against that depth so edges hide behind near spheres.
+use super::projection::{Camera, Projection};
 use super::theme::{Palette, Ramp};
 use crate::engine::SphereView;
 use ratatui::buffer::Buffer;
@@ -84,9 +84,6 @@ pub struct Raster {
     depth: Vec<f32>,
     shade: Vec<u8>,
     level: Vec<u8>,
-    projected: Vec<Projected>,
-    /// Far-to-near order: inverted depth bits above the sphere index.
-    order: Vec<u64>,
 }
 
 impl Raster {
@@ -132,47 +129,32 @@ impl Raster {
 
     fn spheres(&mut self, spheres: &[SphereView], scene: &Scene, proj: &Projection) {
         let (near, far) = proj.depth_range();
-        let mean_sq =
-            spheres.iter().map(|s| s.speed * s.speed).sum::<f64>() / spheres.len().max(1) as f64;
+        let mean_sq = spheres
+            .iter()
+            .map(|s| f64::from(s.speed).powi(2))
+            .sum::<f64>()
+            / spheres.len().max(1) as f64;
         // Twice the rms speed is "hot": a Maxwell gas spreads over the ramp.
         let hot = 2.0 * mean_sq.sqrt();
-        let mut order = std::mem::take(&mut self.order);
-        let mut projected = std::mem::take(&mut self.projected);
-        order.clear();
-        projected.clear();
-        for s in spheres {
-            let p = proj.project(s.pos);
-            if let Some(p) = p {
-                // Depths are positive, so their bits sort like the numbers;
-                // inverted, the farthest comes first.
-                let key = !(p.depth as f32).to_bits();
-                order.push((u64::from(key) << 32) | projected.len() as u64);
-            }
-            projected.push(p.unwrap_or(Projected {
-                x: 0.0,
-                y: 0.0,
-                depth: 0.0,
-                unit: 0.0,
-            }));
-        }
-        order.sort_unstable();
         let (pw, ph) = proj.pixel_size();
         let light = light_dir(scene.light);
         let ring = scene.style != DrawStyle::Shaded;
-        for &key in &order {
-            let i = (key & 0xffff_ffff) as usize;
-            let (s, p) = (&spheres[i], projected[i]);
+        // In the spheres' own order: the depth test keeps the nearest at
+        // each pixel, ties going to the later sphere, which is what drawing
+        // them back to front gave, without sorting 100 000 of them.
+        for s in spheres {
+            let Some(p) = proj.project(s.pos.map(f64::from)) else {
+                continue;
+            };
             let t = match scene.style.ramp() {
-                Ramp::Speed if hot > 0.0 => s.speed / hot,
+                Ramp::Speed if hot > 0.0 => f64::from(s.speed) / hot,
                 Ramp::Speed => 0.0,
                 Ramp::Depth => 1.0 - (p.depth - near) / (far - near),
             };
             let level = (t.clamp(0.0, 1.0) * f64::from(RAMP_LEVELS - 1) + 0.5) as u8;
-            let r = s.radius * p.unit; // cell widths
+            let r = f64::from(s.radius) * p.unit; // cell widths
             self.disc(p.x, p.y, r / pw, r / ph, p.depth as f32, level, light, ring);
         }
-        self.order = order;
-        self.projected = projected;
     }
 
     /// A disc with radii `rx`, `ry` in pixels (the same length on screen).
@@ -194,9 +176,11 @@ impl Raster {
             let (x, y) = (floor(cx), floor(cy));
             if x >= 0 && y >= 0 && x < w && y < h {
                 let k = y as usize * self.w + x as usize;
-                self.depth[k] = depth;
-                self.shade[k] = SHADES;
-                self.level[k] = level;
+                if depth <= self.depth[k] {
+                    self.depth[k] = depth;
+                    self.shade[k] = SHADES;
+                    self.level[k] = level;
+                }
             }
             return;
         }
@@ -232,14 +216,18 @@ impl Raster {
                 let (o0, o1) = span(ox * (1.0 - ey * ey).sqrt());
                 for x in (o0..=o1).filter(|x| *x < i0 || *x > i1) {
                     let k = row + x as usize;
-                    self.depth[k] = depth;
-                    self.shade[k] = EMPTY;
+                    if depth <= self.depth[k] {
+                        self.depth[k] = depth;
+                        self.shade[k] = EMPTY;
+                    }
                 }
                 for x in i0..=i1 {
                     let k = row + x as usize;
-                    self.depth[k] = depth;
-                    self.shade[k] = SHADES;
-                    self.level[k] = level;
+                    if depth <= self.depth[k] {
+                        self.depth[k] = depth;
+                        self.shade[k] = SHADES;
+                        self.level[k] = level;
+                    }
                 }
             } else {
                 for x in i0..=i1 {
@@ -247,9 +235,11 @@ impl Raster {
                     let nz = (1.0 - dx * dx - dy * dy).max(0.0).sqrt();
                     let lit = (dx * light[0] + dy * light[1] + nz * light[2]).max(0.0);
                     let k = row + x as usize;
-                    self.depth[k] = depth;
-                    self.shade[k] = 1 + (lit * f64::from(SHADES - 1) + 0.5) as u8;
-                    self.level[k] = level;
+                    if depth <= self.depth[k] {
+                        self.depth[k] = depth;
+                        self.shade[k] = 1 + (lit * f64::from(SHADES - 1) + 0.5) as u8;
+                        self.level[k] = level;
+                    }
                 }
             }
         }
@@ -407,7 +397,11 @@ mod tests {
     }
 
     fn sphere(pos: [f64; 3], radius: f64, speed: f64) -> SphereView {
-        SphereView { pos, radius, speed }
+        SphereView {
+            pos: pos.map(|x| x as f32),
+            radius: radius as f32,
+            speed: speed as f32,
+        }
     }
 
     #[test]

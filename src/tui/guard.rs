@@ -19,6 +19,8 @@ pub enum Msg {
     Status(std::time::Instant),
     /// The `output` thread finished writing a chunk.
     Written,
+    /// The physics finished a frame.
+    PhysicsDone,
     Resize,
     /// A termination signal (its number).
     Signal(i32),

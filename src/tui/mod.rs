@@ -24,7 +24,7 @@ pub mod theme;
 pub mod threads;
 pub mod writer;
 
-pub use run::{AfterFirstFrame, run, run_with};
+pub use run::{AfterFirstFrame, RunExtras, run, run_with};
 pub use theme::ColorChoice;
 
 /// Largest frame rate the frame loop takes (`--fps`).

@@ -128,7 +128,7 @@ impl Readouts<'_> {
         vec![
             row("threading", self.threading()),
             row("tick", tick),
-            row("count", format!("{}", snap.spheres.len())),
+            row("count", format!("{}", snap.count)),
             row("radius", self.radius()),
             row("model", model_row(s.model, snap.parts)),
             row("style", s.style.name().to_string()),
@@ -205,7 +205,7 @@ impl Readouts<'_> {
                 // reader (or a test) takes the tick from the first word.
                 format!("{} step{}", s.tick, if s.tick == 1 { "" } else { "s" }),
                 "count",
-                snap.spheres.len().to_string(),
+                snap.count.to_string(),
             ),
             pair("radius", self.radius(), "model", model),
             pair("fps", self.fps(true), "physics", self.physics_ms()),

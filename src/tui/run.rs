@@ -10,7 +10,7 @@ use super::theme::Palette;
 use super::writer::Output;
 use super::{MAX_FPS, Options, input, reader};
 use crate::cpu::{CpuReport, Sampler};
-use crate::engine::{Command, Engine, Settings, Snapshot};
+use crate::engine::{Command, Engine, Rebuild, Settings, Snapshot};
 use crate::error::BadInput;
 use crate::physics::World;
 use anyhow::{Context, anyhow};
@@ -28,21 +28,35 @@ use std::time::{Duration, Instant};
 const SAMPLE_PERIOD: Duration = Duration::from_secs(1);
 
 /// Called once on the frame loop's thread when the first frame has gone to
-/// the terminal (`examples/panic_probe.rs` uses it; the app passes none).
+/// the terminal.
 pub type AfterFirstFrame = Box<dyn FnOnce()>;
+
+/// What a caller may add to [`run`].
+#[derive(Default)]
+pub struct RunExtras {
+    /// Reset makes the start again from the scene's description instead of
+    /// the engine keeping a copy of the spheres.
+    pub rebuild: Option<Rebuild>,
+    /// For `examples/panic_probe.rs`; the app passes none.
+    pub after_first_frame: Option<AfterFirstFrame>,
+}
 
 /// Open the screen on `world` and run until the user quits.
 pub fn run(world: World, settings: Settings, opts: Options) -> anyhow::Result<()> {
-    run_with(world, settings, opts, None)
+    run_with(world, settings, opts, RunExtras::default())
 }
 
-/// [`run`], calling `after_first_frame` once the first frame is out.
+/// [`run`], with what `extras` adds.
 pub fn run_with(
     world: World,
     settings: Settings,
     opts: Options,
-    after_first_frame: Option<AfterFirstFrame>,
+    extras: RunExtras,
 ) -> anyhow::Result<()> {
+    let RunExtras {
+        rebuild,
+        after_first_frame,
+    } = extras;
     if !(opts.fps.is_finite() && opts.fps > 0.0 && opts.fps <= MAX_FPS) {
         return Err(BadInput(format!(
             "--fps must be greater than 0 and at most {MAX_FPS}, got {}",
@@ -70,9 +84,18 @@ pub fn run_with(
         world.spheres.iter().map(|s| s.radius).fold(0.0, f64::max),
         opts.fps,
     );
-    let engine = Engine::new(world, settings)?;
+    let engine = match rebuild {
+        Some(r) => Engine::with_rebuild(world, settings, r)?,
+        None => Engine::new(world, settings)?,
+    };
 
     let (tx, rx) = crossbeam_channel::unbounded();
+    // A frame slower than the frame period is collected when it is done,
+    // not at the next period's start.
+    let done = tx.clone();
+    engine.set_notify(Box::new(move || {
+        let _ = done.send(Msg::PhysicsDone);
+    }));
     let guard = Guard::enter(tx.clone()).context("cannot set up the terminal")?;
     let signals = guard::spawn_signals(tx.clone())?;
     reader::spawn_input(tx.clone())?;
@@ -92,6 +115,7 @@ pub fn run_with(
 
 type Term = Terminal<Lean<Counting<Sink>>>;
 
+#[allow(clippy::struct_excessive_bools)] // independent flags of the loop's state
 struct FrameLoop {
     engine: Engine,
     state: AppState,
@@ -117,6 +141,9 @@ struct FrameLoop {
     pending: bool,
     /// A frame was started and not finished; whether it applied commands.
     in_flight: Option<bool>,
+    /// A period began while the physics was still busy: its frame is drawn
+    /// as soon as the physics is done.
+    late: bool,
     /// Something on screen would change.
     dirty: bool,
     window: Window,
@@ -180,6 +207,7 @@ impl FrameLoop {
             sent_tick,
             pending: false,
             in_flight: None,
+            late: false,
             dirty: true,
             window: Window {
                 start: Some(Instant::now()),
@@ -232,6 +260,10 @@ impl FrameLoop {
                 let period = Duration::from_secs_f64(1.0 / self.state.fps);
                 next_frame = later(next_frame, period, now);
                 self.frame()?;
+            } else if self.late && self.engine.frame_ready() {
+                // In place of the frame the physics missed: never more
+                // frames than periods.
+                self.frame()?;
             } else {
                 self.present()?;
             }
@@ -260,6 +292,7 @@ impl FrameLoop {
                 self.pacer.written();
                 Ok(false)
             }
+            Msg::PhysicsDone => Ok(false),
             Msg::Resize => {
                 self.aspect = cell_aspect();
                 self.terminal.autoresize()?;
@@ -280,8 +313,10 @@ impl FrameLoop {
         if self.in_flight.is_some() && !self.engine.frame_ready() {
             // The physics is slower than the frame rate: keep drawing and
             // answering keys on the last snapshot rather than wait for it.
+            self.late = true;
             return self.present();
         }
+        self.late = false;
         if let Some(applied) = self.in_flight.take() {
             let snap = self.engine.finish_frame()?;
             self.window.steps += snap.steps;

@@ -233,7 +233,7 @@ impl AppState {
     /// limit; reset restores the scene). `applied`: this frame applied our
     /// commands, so its notice (or the lack of one) answers them.
     pub fn sync(&mut self, snap: &Snapshot, applied: bool) {
-        self.count = snap.spheres.len();
+        self.count = snap.count;
         if let Some(r) = representative_radius(snap) {
             self.radius = r;
         }
@@ -246,5 +246,5 @@ impl AppState {
 /// The radius the `r`/`R` keys scale: the largest one (for mixed scenes the
 /// largest sphere is what hits the limit first).
 pub fn representative_radius(snap: &Snapshot) -> Option<f64> {
-    snap.spheres.iter().map(|s| s.radius).reduce(f64::max)
+    snap.max_radius
 }

@@ -1,18 +1,18 @@
 //! One cluster's contact events within a step, on private copies of its
 //! spheres: the serial event loop of `swept` (time order, lazy clocks,
 //! collision counters, rescans on every velocity change), run for a set of
-//! spheres that should not touch anyone outside it. An outsider with no
-//! events of its own that a member meets joins the run (the caller sees it
-//! if two runs took the same one in); a member of another cluster, whose
+//! spheres that should not touch anyone outside it. A bystander (a sphere
+//! with no events of its own) that a member meets joins the run (the caller
+//! sees it if it joined two runs); a member of another cluster, whose
 //! path is not known here, is only noted, and the caller checks the two
 //! paths once both runs are done (see `rounds`). Each member's path is kept
 //! as the turns it took.
+use super::partition::Slot;
 use super::{NONE, REACH_SLACK, path_ball};
 use crate::physics::broad::Grid;
 use crate::physics::contact::{pair_toi, reflect_walls, resolve_pair, wall_toi};
 use crate::physics::flight::fly;
 use crate::physics::sphere::Sphere;
-use crate::physics::swept::pair_mut;
 use glam::DVec3;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -21,6 +21,11 @@ use std::collections::BinaryHeap;
 /// rescan; bigger ones (and the absorbing run) find members through the
 /// grid.
 const SMALL_RUN: usize = 32;
+/// A ball may grow to this many times its grid level's widest and still be
+/// found through the grid: wider searches cost more each, a narrower cap
+/// puts more balls on the run's own `grown` list (docs/benchmarks.md, "tuned
+/// constants").
+const GROWTH_CAP: f64 = 1.25;
 
 /// An event's own cost in pair checks: the queue, the grid cells its
 /// rescans visit, its turns kept and compared (measured: about 400 pair
@@ -36,8 +41,8 @@ const FOUND_WORK: u64 = 4;
 pub(super) struct Shared<'a> {
     pub spheres: &'a [Sphere],
     pub grid: &'a Grid,
-    /// Sphere id → its slot among the involved spheres, or NONE.
-    pub slot: &'a [u32],
+    /// Sphere id → its slot among the involved spheres, or `Slot::NONE`.
+    pub slot: &'a [Slot],
     /// By slot of the first round: where its partners among the step's
     /// pairs start in `partners` (see [`Shared::partners_of`]).
     pub partner_start: &'a [u32],
@@ -51,8 +56,8 @@ pub(super) struct Shared<'a> {
 impl Shared<'_> {
     /// Every sphere whose binned ball meets the binned ball of the sphere
     /// in `slot`, if that slot was indexed.
-    fn partners_of(&self, slot: u32) -> Option<&[u32]> {
-        let s = slot as usize;
+    fn partners_of(&self, slot: Slot) -> Option<&[u32]> {
+        let s = slot.index();
         let end = *self.partner_start.get(s.checked_add(1)?)?;
         Some(&self.partners[self.partner_start[s] as usize..end as usize])
     }
@@ -68,6 +73,24 @@ pub enum Coarse {
     Work,
 }
 
+/// A sphere's index among a run's members: what the run's tables are
+/// indexed with, never a sphere id or a slot.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Local(u32);
+
+impl Local {
+    /// Not a member (of the run, or the wall of a wall event).
+    const NONE: Local = Local(u32::MAX);
+
+    fn at(index: usize) -> Local {
+        Local(index as u32)
+    }
+
+    fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
 /// An event; `a`, `b` are sphere ids (`b` NONE for a wall), `la`, `lb` the
 /// run's local indices, `ca`, `cb` the collision counts it was predicted at.
 #[derive(Clone, Copy, Debug)]
@@ -75,8 +98,8 @@ struct Event {
     t: f64,
     a: u32,
     b: u32,
-    la: u32,
-    lb: u32,
+    la: Local,
+    lb: Local,
     ca: u32,
     cb: u32,
 }
@@ -106,7 +129,7 @@ impl Ord for Event {
 /// A turn in a member's path: from time `t` of the step it is at
 /// `pos + vel (t' - t)`, until its next turn.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Kink {
+pub(super) struct Turn {
     pub t: f64,
     pub pos: DVec3,
     pub vel: DVec3,
@@ -116,9 +139,9 @@ pub(super) struct Kink {
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Member {
     pub id: u32,
-    /// Its slot among the spheres with events when the run began (NONE for
-    /// one the run took in).
-    pub slot: u32,
+    /// Its slot among the spheres with events when the run began
+    /// (`Slot::NONE` for a bystander that joined the run).
+    pub slot: Slot,
     pub sphere: Sphere,
     /// Momentum given to the walls, for the pressure.
     pub wall_momentum: f64,
@@ -130,20 +153,20 @@ pub(super) struct Member {
     pub centre: DVec3,
     pub reach: f64,
     pub grew: bool,
-    /// Its turns: `kinks` of them from `kink0` on, in time order, in the
-    /// run's [`Run::kinks`] (then wherever the caller copies them).
-    pub kink0: u32,
-    pub kinks: u32,
+    /// Its turns: `turns` of them from `turn0` on, in time order, in the
+    /// run's [`Run::turns`] (then wherever the caller copies them).
+    pub turn0: u32,
+    pub turns: u32,
 }
 
 /// Scratch for one run, kept to reuse memory.
 #[derive(Default)]
 pub(super) struct Run {
     ids: Vec<u32>,
-    slots: Vec<u32>,
-    /// Sphere id → local index for members, NONE for everyone else; kept
-    /// so between runs (one lookup per candidate, the hot path).
-    local_of: Vec<u32>,
+    slots: Vec<Slot>,
+    /// Sphere id → local index for members, `Local::NONE` for everyone
+    /// else; kept so between runs (one lookup per candidate, the hot path).
+    local_of: Vec<Local>,
     sp: Vec<Sphere>,
     t_local: Vec<f64>,
     count: Vec<u32>,
@@ -160,9 +183,9 @@ pub(super) struct Run {
     found: Vec<u32>,
     /// Turns, by local index, in the order they happened; sorted by member
     /// when the run ends.
-    turns: Vec<(u32, Kink)>,
-    kinks: Vec<Kink>,
-    kink_at: Vec<(u32, u32)>,
+    turn_log: Vec<(u32, Turn)>,
+    turns: Vec<Turn>,
+    turn_at: Vec<(u32, u32)>,
     /// (member, member of another cluster) whose balls met: the caller
     /// compares their paths when both runs are done.
     pub cross: Vec<(u32, u32)>,
@@ -185,7 +208,7 @@ impl Run {
         }
         self.events(sh, pairs, absorb);
         for &i in &self.ids {
-            self.local_of[i as usize] = NONE;
+            self.local_of[i as usize] = Local::NONE;
         }
         self.cross.sort_unstable();
         self.cross.dedup();
@@ -194,7 +217,7 @@ impl Run {
     fn events(&mut self, sh: &Shared, pairs: &[(u32, u32)], absorb: bool) {
         for &(i, j) in pairs {
             let (a, b) = (self.local_of[i as usize], self.local_of[j as usize]);
-            let (si, sj) = (&self.sp[a as usize], &self.sp[b as usize]);
+            let (si, sj) = (&self.sp[a.index()], &self.sp[b.index()]);
             if let Some(t) = pair_toi(si.pos - sj.pos, si.vel - sj.vel, si.radius + sj.radius) {
                 self.heap.push(pair_event(t, i, j, a, b, 0, 0));
             }
@@ -204,7 +227,7 @@ impl Run {
         self.work = pairs.len() as u64;
         let mut done = 0usize;
         while let Some(e) = self.heap.pop() {
-            let (la, lb) = (e.la as usize, e.lb as usize);
+            let (la, lb) = (e.la.index(), e.lb.index());
             if self.count[la] != e.ca || (e.b != NONE && self.count[lb] != e.cb) {
                 continue;
             }
@@ -230,7 +253,10 @@ impl Run {
             } else {
                 self.advance_to(lb, e.t);
                 self.count[lb] += 1;
-                let (x, y) = pair_mut(&mut self.sp, la, lb);
+                // Two members: a pair event never names one sphere twice.
+                let Ok([x, y]) = self.sp.get_disjoint_mut([la, lb]) else {
+                    unreachable!("a pair event of one sphere");
+                };
                 if resolve_pair(x, y) {
                     self.pair_hits[la.min(lb)] += 1;
                 }
@@ -261,26 +287,26 @@ impl Run {
             self.wall_hits[l] += hits as u32;
         }
         // Each member's turns together, still in time order (stable sort).
-        self.turns.sort_by_key(|&(l, _)| l);
-        self.kinks.clear();
-        self.kink_at.clear();
-        self.kink_at.resize(self.ids.len(), (0, 0));
-        for &(l, k) in &self.turns {
-            let at = &mut self.kink_at[l as usize];
+        self.turn_log.sort_by_key(|&(l, _)| l);
+        self.turns.clear();
+        self.turn_at.clear();
+        self.turn_at.resize(self.ids.len(), (0, 0));
+        for &(l, k) in &self.turn_log {
+            let at = &mut self.turn_at[l as usize];
             if at.1 == 0 {
-                at.0 = self.kinks.len() as u32;
+                at.0 = self.turns.len() as u32;
             }
             at.1 += 1;
-            self.kinks.push(k);
+            self.turns.push(k);
         }
     }
 
     /// Member `l` changed velocity at `t` (it is there now).
     fn turn(&mut self, l: usize, t: f64) {
         let s = &self.sp[l];
-        self.turns.push((
+        self.turn_log.push((
             l as u32,
-            Kink {
+            Turn {
                 t,
                 pos: s.pos,
                 vel: s.vel,
@@ -288,9 +314,9 @@ impl Run {
         ));
     }
 
-    /// The turns of the last finished run's members (see [`Member::kink0`]).
-    pub fn kinks(&self) -> &[Kink] {
-        &self.kinks
+    /// The turns of the last finished run's members (see [`Member::turn0`]).
+    pub fn turns(&self) -> &[Turn] {
+        &self.turns
     }
 
     /// The members of the last finished run.
@@ -305,14 +331,14 @@ impl Run {
             centre: self.centre[l],
             reach: self.reach[l],
             grew: self.reach[l] > self.reach0[l],
-            kink0: self.kink_at[l].0,
-            kinks: self.kink_at[l].1,
+            turn0: self.turn_at[l].0,
+            turns: self.turn_at[l].1,
         })
     }
 
     fn clear(&mut self, n: usize) {
         if self.local_of.len() < n {
-            self.local_of.resize(n, NONE);
+            self.local_of.resize(n, Local::NONE);
         }
         self.ids.clear();
         self.slots.clear();
@@ -328,7 +354,7 @@ impl Run {
         self.wall_hits.clear();
         self.pair_hits.clear();
         self.heap.clear();
-        self.turns.clear();
+        self.turn_log.clear();
         self.capped = None;
         self.work = 0;
         self.cross.clear();
@@ -338,15 +364,15 @@ impl Run {
     #[inline(always)]
     fn member(&self, j: u32) -> Option<usize> {
         match self.local_of[j as usize] {
-            NONE => None,
-            l => Some(l as usize),
+            Local::NONE => None,
+            l => Some(l.index()),
         }
     }
 
     /// Adds sphere `i` (at the start of the step) to the run; returns its
     /// local index.
-    fn involve(&mut self, sh: &Shared, i: u32) -> u32 {
-        let l = self.ids.len() as u32;
+    fn involve(&mut self, sh: &Shared, i: u32) -> Local {
+        let l = Local::at(self.ids.len());
         let s = sh.spheres[i as usize];
         self.local_of[i as usize] = l;
         self.ids.push(i);
@@ -358,7 +384,7 @@ impl Run {
         self.centre.push(centre);
         self.reach.push(reach);
         self.reach0.push(reach);
-        self.cap.push(sh.grid.growth_cap(reach));
+        self.cap.push(GROWTH_CAP * sh.grid.widest_in_level(reach));
         self.wall_momentum.push(0.0);
         self.wall_hits.push(0);
         self.pair_hits.push(0);
@@ -391,7 +417,16 @@ impl Run {
             self.reach[la] = need;
         }
         let ca = self.count[la];
-        push_wall(&mut self.heap, &sa, ia, la as u32, t, ca, sh.size, sh.dt);
+        push_wall(
+            &mut self.heap,
+            &sa,
+            ia,
+            Local::at(la),
+            t,
+            ca,
+            sh.size,
+            sh.dt,
+        );
         let mut found = std::mem::take(&mut self.found);
         found.clear();
         // Only what is left of the path can meet anyone: the ball around
@@ -405,8 +440,8 @@ impl Run {
         let mut seen = 0u64;
         if !absorb && self.ids.len() <= SMALL_RUN {
             // Members are few: they are checked one by one with their grown
-            // balls, so the grid is searched only for outsiders.
-            let mut outsider = |j: u32, pj0: DVec3, rj: f64| {
+            // balls, so the grid is searched only for non-members.
+            let mut non_member = |j: u32, pj0: DVec3, rj: f64| {
                 seen += 1;
                 // The distance first: it reads what the grid handed over,
                 // the member table is a read elsewhere in memory.
@@ -416,17 +451,17 @@ impl Run {
             };
             // When the ball around the rest of the path lies inside the
             // sphere's binned ball (well inside: far above rounding), every
-            // outsider it can meet is one of the pairs the grid already
+            // non-member it can meet is one of the pairs the grid already
             // found for it, and the same test picks the same ones.
             let inside = (q - this.centre[la]).length() + rq <= this.reach0[la] * (1.0 - 1e-9);
             match sh.partners_of(this.slots[la]).filter(|_| inside) {
                 Some(partners) => {
                     for &j in partners {
                         let (pj0, rj) = path_ball(&sh.spheres[j as usize], sh.dt);
-                        outsider(j, pj0, rj);
+                        non_member(j, pj0, rj);
                     }
                 }
-                None => sh.grid.near_binned(q, rq, &mut outsider),
+                None => sh.grid.near(q, rq, 1.0, &mut non_member),
             }
             seen += this.ids.len() as u64;
             for l in 0..this.ids.len() {
@@ -436,7 +471,7 @@ impl Run {
                 }
             }
         } else {
-            // Outsiders are judged by the ball the grid holds for them: a
+            // Non-members are judged by the ball the grid holds for them: a
             // run never reads another run's state. A member grown past its
             // cap is no longer found through the grid, so `grown` is
             // checked by hand.
@@ -447,7 +482,7 @@ impl Run {
                     found.push(j);
                 }
             };
-            sh.grid.near(q, rq, &mut consider);
+            sh.grid.near(q, rq, GROWTH_CAP, &mut consider);
             for &g in &this.grown {
                 let lg = g as usize;
                 consider(this.ids[lg], this.centre[lg], this.reach[lg]);
@@ -462,26 +497,23 @@ impl Run {
                 continue;
             }
             let l = self.member(j);
-            if l.is_none() && sh.slot[j as usize] != NONE {
+            if l.is_none() && !sh.slot[j as usize].is_none() {
                 // A member of another cluster whose ball meets ours: its path
                 // is not known here, so the caller compares the paths.
                 self.cross.push((ia, j));
                 continue;
             }
-            let s = match l {
-                Some(l) => {
-                    let s = &self.sp[l];
-                    Sphere {
-                        pos: s.pos + s.vel * (t - self.t_local[l]),
-                        ..*s
-                    }
+            let s = if let Some(l) = l {
+                let s = &self.sp[l];
+                Sphere {
+                    pos: s.pos + s.vel * (t - self.t_local[l]),
+                    ..*s
                 }
-                None => {
-                    let s = &sh.spheres[j as usize];
-                    Sphere {
-                        pos: s.pos + s.vel * t,
-                        ..*s
-                    }
+            } else {
+                let s = &sh.spheres[j as usize];
+                Sphere {
+                    pos: s.pos + s.vel * t,
+                    ..*s
                 }
             };
             let Some(dtc) = pair_toi(sa.pos - s.pos, sa.vel - s.vel, sa.radius + s.radius) else {
@@ -490,21 +522,21 @@ impl Run {
             if t + dtc > sh.dt {
                 continue;
             }
-            // A sphere with no events that a member meets joins the run;
-            // if another run took it in too, the caller sees it taken twice.
+            // A bystander that a member meets joins the run; if it joined
+            // another run too, the caller sees it joined twice.
             let lb = match l {
-                Some(l) => l as u32,
+                Some(l) => Local::at(l),
                 None => self.involve(sh, j),
             };
-            let cb = self.count[lb as usize];
+            let cb = self.count[lb.index()];
             self.heap
-                .push(pair_event(t + dtc, ia, j, la as u32, lb, ca, cb));
+                .push(pair_event(t + dtc, ia, j, Local::at(la), lb, ca, cb));
         }
         self.found = found;
     }
 }
 
-fn pair_event(t: f64, a: u32, b: u32, la: u32, lb: u32, ca: u32, cb: u32) -> Event {
+fn pair_event(t: f64, a: u32, b: u32, la: Local, lb: Local, ca: u32, cb: u32) -> Event {
     if a < b {
         Event {
             t,
@@ -533,7 +565,7 @@ fn push_wall(
     heap: &mut BinaryHeap<Event>,
     s: &Sphere,
     a: u32,
-    la: u32,
+    la: Local,
     t: f64,
     ca: u32,
     size: f64,
@@ -546,7 +578,7 @@ fn push_wall(
             a,
             b: NONE,
             la,
-            lb: NONE,
+            lb: Local::NONE,
             ca,
             cb: 0,
         });

@@ -19,6 +19,9 @@
 //! scenes), a step is cut into equal parts, each run as above, so the
 //! pairs and clusters stay those of short paths (`parts.rs`).
 mod cluster;
+mod conflicts;
+mod group;
+mod partition;
 mod parts;
 mod rounds;
 
@@ -33,6 +36,7 @@ use super::world::World;
 use cluster::Coarse;
 use glam::DVec3;
 use parking_lot::Mutex;
+pub use parts::ADDED_PAIRS;
 pub use rounds::RoundStats;
 use rounds::Rounds;
 
@@ -393,14 +397,4 @@ fn reaches_wall(s: &Sphere, size: f64, dt: f64) -> bool {
     let (lo, hi) = (s.radius, size - s.radius);
     // `|`, not `||`: one well-predicted branch instead of four.
     (end.min(s.pos).min_element() <= lo) | (end.max(s.pos).max_element() >= hi)
-}
-
-pub(crate) fn pair_mut<T>(v: &mut [T], i: usize, j: usize) -> (&mut T, &mut T) {
-    if i < j {
-        let (lo, hi) = v.split_at_mut(j);
-        (&mut lo[i], &mut hi[0])
-    } else {
-        let (lo, hi) = v.split_at_mut(i);
-        (&mut hi[0], &mut lo[j])
-    }
 }

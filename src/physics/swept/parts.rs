@@ -24,15 +24,10 @@ const SAMPLE_MIN: usize = 64;
 const SAMPLE_MAX: usize = 1024;
 /// No more parts than this.
 pub const MAX_PARTS: u32 = 256;
-/// Pairs per sphere the motion may add in one part. Measured
-/// (`examples/step` with its `parts` argument, `ballpit bench`), the best k
-/// of each scene added: gas at packing 0.1, 0.24 (10k, k = 2, 15 % faster)
-/// and 0.31 (100k, k = 4, 3×); dense (0.4) 2k, 0.32 (k = 6, 1.6×) and 100k,
-/// under 0.4 (k = 24–32, 5×); projectiles 200, 0.34 (k = 4, 2.2×), 1 000,
-/// 0.29 (k = 8, 5.6×). At the edge: 100 000 at packing 0.005 adds 0.36
-/// whole, and two parts are 8–15 % faster; 10 000 at 0.042 adds 0.32
-/// whole, and two parts are 8 % slower.
-const ADDED_PAIRS: f64 = 0.34;
+/// Pairs per sphere the motion may add in one part: fewer parts cost more
+/// pairs and bigger clusters, more parts more passes over everyone; this
+/// balances them (docs/benchmarks.md, "tuned constants").
+pub const ADDED_PAIRS: f64 = 0.34;
 
 /// Moments of a sphere's path-ball reach `r + s τ` (`s` its speed), as
 /// sums over the sample of `r^a s^b`, for every τ at once.

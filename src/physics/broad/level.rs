@@ -1,0 +1,452 @@
+//! One uniform grid level of the broad phase: spheres binned by the cell
+//! of their ball's centre (a counting sort by cell key), the same-level
+//! pairs, and the searches around a point or along the faces of the box.
+use super::super::exec::Exec;
+use glam::DVec3;
+use parking_lot::Mutex;
+
+/// Cell keys per parallel block; fixed so results never depend on the
+/// thread count.
+const KEY_BLOCK: usize = 2048;
+/// From this many spheres per lane on, the sort into cells places indices,
+/// then copies the records (measured: 3–6 % faster at 100 000 spheres, no
+/// gain at 10 000, where everything stays in cache).
+const INDIRECT_MIN: usize = 1 << 15;
+
+/// A sphere's ball for the step: it stays within `reach` of `pos`.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Ball {
+    pub(super) pos: DVec3,
+    pub(super) reach: f64,
+}
+
+/// A sphere in a level: its ball, id and padded cell key (on its way into
+/// the first level, `u32::MAX` when too wide for it). One record, so that
+/// sorting it into place writes one place in memory, not three.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Entry {
+    pub(super) ball: Ball,
+    pub(super) id: u32,
+    pub(super) key: u32,
+}
+
+/// A ball within reach of nothing (NaN compares false), padding the pair
+/// loops' candidate lists.
+pub(super) const NOWHERE: Ball = Ball {
+    pos: DVec3::NAN,
+    reach: f64::NAN,
+};
+/// One uniform grid. It is padded with one empty layer of cells on every
+/// side, so the neighbour cells of any real cell exist and need no bounds
+/// checks: the 13 forward neighbours of cell `c` are 5 contiguous key ranges
+/// at fixed offsets from `c`.
+#[derive(Default)]
+pub(super) struct Level {
+    /// Real cells per side.
+    pub(super) per_side: usize,
+    /// Padded cells per side (`per_side + 2`).
+    side: usize,
+    /// The last real cell's coordinate, `per_side - 1`.
+    last_cell: f64,
+    inv_cell: f64,
+    pub(super) cell: f64,
+    pub(super) cell_start: Vec<u32>,
+    /// The spheres of this level sorted by cell key, then a `NOWHERE` pad.
+    pub(super) entries: Vec<Entry>,
+    /// Per lane of `fill_lanes`: where each of its entries comes from.
+    orders: Vec<Mutex<Vec<u32>>>,
+    /// Largest reach in this level.
+    pub(super) reach_max: f64,
+}
+
+/// Real cell coordinates of `p`, clamped into `0..=last`. Truncation is
+/// floor here (after max(0)), without a libm call; clamping in floating
+/// point first (NaN goes to 0) lets the cast be a 32-bit one. `last` comes
+/// as a float: converting it here cost as much as the rest.
+#[inline]
+fn cell_coords(p: DVec3, inv_cell: f64, last: f64) -> [usize; 3] {
+    let c = |x: f64| (x * inv_cell).max(0.0).min(last) as u32 as usize;
+    [c(p.x), c(p.y), c(p.z)]
+}
+
+/// Inclusive running sums of `counts`, from `start` on; returns the last.
+/// The table has several cells per sphere, so this pass is long: each
+/// block of eight is summed on its own and only the blocks' totals form a
+/// chain, one add per eight cells instead of one per cell.
+fn running_sums(counts: &mut [u32], start: u32) -> u32 {
+    let mut end = start;
+    let (blocks, rest) = counts.as_chunks_mut::<8>();
+    for block in blocks {
+        let mut v = *block;
+        // Sums within the block by doubling shifts: vector adds, no chain.
+        for shift in [1, 2, 4] {
+            let prev = v;
+            for k in shift..8 {
+                v[k] += prev[k - shift];
+            }
+        }
+        for (c, l) in block.iter_mut().zip(v) {
+            *c = end + l;
+        }
+        end += v[7];
+    }
+    for c in rest {
+        end += *c;
+        *c = end;
+    }
+    end
+}
+/// Room for `n` entries and the `NOWHERE` pad; the old contents stay (the
+/// scatter writes every slot), so no serial pass clears them. Takes the
+/// entries, not the level, so it can run while the cell table is lent out.
+fn room(entries: &mut Vec<Entry>, n: usize) {
+    entries.truncate(n);
+    entries.resize(n, Entry::default());
+    entries.push(Entry {
+        ball: NOWHERE,
+        ..Entry::default()
+    });
+}
+impl Level {
+    /// Sizes the level for `n` spheres wanting cells of `want`. The cell
+    /// table is zeroed here unless `lanes_zero` (the lanes of `fill_lanes`
+    /// zero their own parts: at 100 000 spheres the table is megabytes).
+    pub(super) fn shape(&mut self, size: f64, want: f64, n: usize, lanes_zero: bool) {
+        // At most ~4 cells per sphere and 1024 per side keep memory O(N).
+        // Empty cells are cheap to skip in the search, but every step counts,
+        // sums and reads the whole table: with 8 per sphere, 100 000 dilute
+        // spheres ran 3 % slower (the table left the cache), 10 000 1 %.
+        let cap = ((4 * n.max(1)) as f64).cbrt().ceil().clamp(1.0, 1024.0);
+        self.per_side = (size / want.max(f64::MIN_POSITIVE)).floor().clamp(1.0, cap) as usize;
+        self.side = self.per_side + 2;
+        self.cell = size / self.per_side as f64;
+        self.inv_cell = 1.0 / self.cell;
+        self.last_cell = (self.per_side - 1) as f64;
+        self.reach_max = 0.0;
+        let len = self.side * self.side * self.side + 1;
+        if lanes_zero {
+            self.cell_start.resize(len, 0);
+        } else {
+            self.cell_start.clear();
+            self.cell_start.resize(len, 0);
+        }
+    }
+
+    /// Sphere `id`'s record on its way into this level: its cell's key,
+    /// or `u32::MAX` and a place in `wide` when its ball is too wide.
+    #[inline(always)]
+    pub(super) fn stage(
+        &self,
+        (pos, reach): (DVec3, f64),
+        id: u32,
+        wide: &mut Vec<(Ball, u32)>,
+    ) -> Entry {
+        let ball = Ball { pos, reach };
+        let key = if self.fits(reach) {
+            self.key_of(pos)
+        } else {
+            wide.push((ball, id));
+            u32::MAX
+        };
+        Entry { ball, id, key }
+    }
+
+    #[inline]
+    pub(super) fn fits(&self, reach: f64) -> bool {
+        2.0 * reach <= self.cell
+    }
+
+    #[inline]
+    pub(super) fn key_of(&self, p: DVec3) -> u32 {
+        let [x, y, z] = cell_coords(p, self.inv_cell, self.last_cell);
+        ((x + 1) + self.side * ((y + 1) + self.side * (z + 1))) as u32
+    }
+
+    /// Counting sort of `items` (ball, id, key), stable, in place: counts go
+    /// to `cell_start[key]`, inclusive prefix sums make that the end of each
+    /// cell, and placing the items in reverse order walks each end down to
+    /// the cell's start.
+    pub(super) fn fill(&mut self, items: &[Entry]) {
+        for e in items {
+            self.reach_max = self.reach_max.max(e.ball.reach);
+            self.cell_start[e.key as usize] += 1;
+        }
+        let cells = self.cell_start.len() - 1;
+        let sum = running_sums(&mut self.cell_start[..cells], 0);
+        self.cell_start[cells] = sum;
+        room(&mut self.entries, sum as usize);
+        for e in items.iter().rev() {
+            let slot = &mut self.cell_start[e.key as usize];
+            *slot -= 1;
+            self.entries[*slot as usize] = *e;
+        }
+    }
+
+    /// The same counting sort as [`Level::fill`] for the first level, cut
+    /// by key range over the executor's lanes: each lane counts, sums and
+    /// places only the keys of its range, into its own part of the cell
+    /// table and of the entries, so the layout is the same for any number
+    /// of lanes.
+    /// `counted`: the cell table already holds the counts of one lane
+    /// (made while staging), with (how many, widest reach).
+    pub(super) fn fill_lanes(
+        &mut self,
+        staged: &[Entry],
+        exec: &dyn Exec,
+        counted: Option<(u32, f64)>,
+    ) {
+        let cells = self.cell_start.len() - 1;
+        let exec: &dyn Exec = if counted.is_some() {
+            &super::super::exec::Serial
+        } else {
+            exec
+        };
+        let lanes = exec.lanes().clamp(1, 64).min(cells);
+        let bounds: Vec<usize> = (0..=lanes).map(|l| l * cells / lanes).collect();
+        let mut tables: Vec<Mutex<&mut [u32]>> = Vec::with_capacity(lanes);
+        let mut rest = &mut self.cell_start[..cells];
+        for l in 0..lanes {
+            let (mine, more) = rest.split_at_mut(bounds[l + 1] - bounds[l]);
+            tables.push(Mutex::new(mine));
+            rest = more;
+        }
+        let totals: Vec<Mutex<(u32, f64)>> = (0..lanes)
+            .map(|_| Mutex::new(counted.unwrap_or((0, 0.0))))
+            .collect();
+        exec.for_each_lane(&|l| {
+            if l >= lanes || counted.is_some() {
+                return;
+            }
+            let (lo, hi) = (bounds[l] as u32, bounds[l + 1] as u32);
+            let mut table = tables[l].lock();
+            table.fill(0);
+            let mut reach_max: f64 = 0.0;
+            let mut count = 0;
+            for s in staged {
+                if s.key >= lo && s.key < hi {
+                    table[(s.key - lo) as usize] += 1;
+                    // Not `f64::max`: its NaN handling makes a slow chain
+                    // through every sphere, and reaches are never NaN here.
+                    if s.ball.reach > reach_max {
+                        reach_max = s.ball.reach;
+                    }
+                    count += 1;
+                }
+            }
+            *totals[l].lock() = (count, reach_max);
+        });
+        let mut offsets = Vec::with_capacity(lanes + 1);
+        let mut sum = 0u32;
+        for t in &totals {
+            let (count, reach_max) = *t.lock();
+            offsets.push(sum);
+            sum += count;
+            self.reach_max = self.reach_max.max(reach_max);
+        }
+        offsets.push(sum);
+        room(&mut self.entries, sum as usize);
+        // Past the caches, a record written anywhere in the entries costs a
+        // miss: a lane then writes only where each record goes (a small
+        // array that stays in cache) and copies the records over in order,
+        // reading them where they lie (reads of misses overlap; writes of
+        // them held the sort up).
+        let indirect = staged.len() / lanes >= INDIRECT_MIN;
+        self.orders.resize_with(lanes, Default::default);
+        let orders = &self.orders;
+        let mut regions: Vec<Mutex<&mut [Entry]>> = Vec::with_capacity(lanes);
+        let mut rest = &mut self.entries[..sum as usize];
+        for l in 0..lanes {
+            let (mine, more) = rest.split_at_mut((offsets[l + 1] - offsets[l]) as usize);
+            regions.push(Mutex::new(mine));
+            rest = more;
+        }
+        exec.for_each_lane(&|l| {
+            if l >= lanes {
+                return;
+            }
+            let (lo, hi) = (bounds[l] as u32, bounds[l + 1] as u32);
+            let mut table = tables[l].lock();
+            running_sums(&mut table, offsets[l]);
+            let mut region = regions[l].lock();
+            if !indirect {
+                for s in staged.iter().rev() {
+                    if s.key >= lo && s.key < hi {
+                        let slot = &mut table[(s.key - lo) as usize];
+                        *slot -= 1;
+                        region[(*slot - offsets[l]) as usize] = *s;
+                    }
+                }
+                return;
+            }
+            let mut order = orders[l].lock();
+            order.resize(region.len(), 0);
+            for (i, s) in staged.iter().enumerate().rev() {
+                if s.key >= lo && s.key < hi {
+                    let slot = &mut table[(s.key - lo) as usize];
+                    *slot -= 1;
+                    order[(*slot - offsets[l]) as usize] = i as u32;
+                }
+            }
+            for (e, &i) in region.iter_mut().zip(order.iter()) {
+                *e = staged[i as usize];
+            }
+        });
+        drop(tables);
+        self.cell_start[cells] = sum;
+    }
+
+    pub(super) fn key_blocks(&self) -> usize {
+        (self.cell_start.len() - 1).div_ceil(KEY_BLOCK)
+    }
+
+    /// Same-level pairs with a sphere in key block `b`, each found once: a
+    /// sphere against the rest of its cell and the next cell along x, and the
+    /// cells x-1..=x+1 of the four forward rows.
+    pub(super) fn block_pairs(
+        &self,
+        b: usize,
+        go: &impl Fn() -> bool,
+        f: &mut impl FnMut(u32, u32),
+    ) {
+        let keys = self.cell_start.len() - 1;
+        let cs = &self.cell_start[..];
+        let entries = &self.entries[..];
+        let nowhere = (entries.len() - 1) as u32;
+        let lo = cs[b * KEY_BLOCK] as usize;
+        let hi = cs[((b + 1) * KEY_BLOCK).min(keys)] as usize;
+        // Nearly every window holds at most a few spheres, so four indices
+        // are copied from each unconditionally and only the real ones
+        // counted, then the candidates are tested four at a time, padded
+        // with `NOWHERE`: a loop that nearly always runs once, where five
+        // short loops had exits the branch predictor could not guess. The
+        // buffer lives across spheres: only what a sphere wrote is read.
+        let mut buf = [nowhere; 4 * 6];
+        // One sphere at a time, its windows looked up afresh: cells hold a
+        // sphere or so, and state kept per cell spilled out of registers.
+        for (i, e) in (lo..).zip(&entries[lo..hi]) {
+            if !go() {
+                return;
+            }
+            let (a, ia) = (&e.ball, e.id);
+            let (mut len, mut all) = (0, 0);
+            for (lo, hi) in self.windows(i, e.key as usize) {
+                let l = lo as u32;
+                buf[len..len + 4].copy_from_slice(&[l, l + 1, l + 2, l + 3]);
+                len += (hi - lo).min(4);
+                all += hi - lo;
+            }
+            buf[len..len + 4].copy_from_slice(&[nowhere; 4]);
+            if all != len {
+                self.wide_pairs(i, f);
+                continue;
+            }
+            for four in buf[..len.next_multiple_of(4)].chunks_exact(4) {
+                let near = |j: u32| within(a, &entries[j as usize].ball);
+                // `|`, not `||`: all four tested without branches.
+                if near(four[0]) | near(four[1]) | near(four[2]) | near(four[3]) {
+                    for &j in four {
+                        if near(j) {
+                            f(ia, entries[j as usize].id);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// The entry ranges the pairs of entry `i` (in cell `c`) come from: the
+    /// rest of its row from the next entry on up to the next cell, then the
+    /// forward rows (y+1, z) and (y-1..=y+1, z+1), cells x-1..=x+1 each.
+    #[inline(always)]
+    fn windows(&self, i: usize, c: usize) -> [(usize, usize); 5] {
+        let (cs, s) = (&self.cell_start[..], self.side);
+        let (r1, r2) = (c + s - 1, c + s * s - s - 1);
+        let w1 = &cs[r1..r1 + 4];
+        let w2 = &cs[r2..r2 + 2 * s + 4];
+        [
+            (i + 1, cs[c + 2] as usize),
+            (w1[0] as usize, w1[3] as usize),
+            (w2[0] as usize, w2[3] as usize),
+            (w2[s] as usize, w2[s + 3] as usize),
+            (w2[2 * s] as usize, w2[2 * s + 3] as usize),
+        ]
+    }
+
+    /// The pairs of entry `i` when a window holds more than four: rare, so
+    /// kept out of the loop's registers.
+    #[cold]
+    #[inline(never)]
+    fn wide_pairs(&self, i: usize, f: &mut impl FnMut(u32, u32)) {
+        let e = &self.entries[i];
+        for (lo, hi) in self.windows(i, e.key as usize) {
+            scan(&e.ball, e.id, &self.entries[lo..hi], f);
+        }
+    }
+
+    /// Indices of the spheres in the cells on the faces of the box.
+    pub(super) fn on_faces(&self, f: &mut impl FnMut(usize)) {
+        if self.entries.len() <= 1 {
+            return;
+        }
+        let (last, s, cs) = (self.per_side - 1, self.side, &self.cell_start);
+        let key = |x: usize, y: usize, z: usize| (x + 1) + s * ((y + 1) + s * (z + 1));
+        for z in 0..=last {
+            for y in 0..=last {
+                let (a, b) = (key(0, y, z), key(last, y, z));
+                if z == 0 || z == last || y == 0 || y == last {
+                    (cs[a] as usize..cs[b + 1] as usize).for_each(&mut *f);
+                } else {
+                    (cs[a] as usize..cs[a + 1] as usize).for_each(&mut *f);
+                    (cs[b] as usize..cs[b + 1] as usize).for_each(&mut *f);
+                }
+            }
+        }
+    }
+
+    /// Indices of the spheres in the cells covering `p ± span`.
+    pub(super) fn near(&self, p: DVec3, span: f64, f: &mut impl FnMut(usize)) {
+        if self.entries.len() <= 1 {
+            return;
+        }
+        let lo = cell_coords(p - DVec3::splat(span), self.inv_cell, self.last_cell);
+        let hi = cell_coords(p + DVec3::splat(span), self.inv_cell, self.last_cell);
+        let cs = &self.cell_start;
+        // As in `block_pairs`: rows hold a sphere or two, so four indices
+        // are copied from each unconditionally and the real ones counted,
+        // and `f` runs in one loop instead of one short loop per row.
+        let mut buf = [0u32; 64];
+        let mut len = 0;
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                let k = (lo[0] + 1) + self.side * ((y + 1) + self.side * (z + 1));
+                let (from, to) = (cs[k], cs[k + hi[0] - lo[0] + 1]);
+                if len + 4 > buf.len() || to - from > 4 {
+                    buf[..len].iter().for_each(|&j| f(j as usize));
+                    len = 0;
+                    if to - from > 4 {
+                        (from as usize..to as usize).for_each(&mut *f);
+                        continue;
+                    }
+                }
+                buf[len..len + 4].copy_from_slice(&[from, from + 1, from + 2, from + 3]);
+                len += (to - from) as usize;
+            }
+        }
+        buf[..len].iter().for_each(|&j| f(j as usize));
+    }
+}
+#[inline(always)]
+pub(super) fn within(a: &Ball, b: &Ball) -> bool {
+    let s = a.reach + b.reach;
+    (a.pos - b.pos).length_squared() <= s * s
+}
+
+/// `f(ia, id)` for each of `entries` within reach of `a`.
+#[inline(always)]
+fn scan(a: &Ball, ia: u32, entries: &[Entry], f: &mut impl FnMut(u32, u32)) {
+    for e in entries {
+        if within(a, &e.ball) {
+            f(ia, e.id);
+        }
+    }
+}

@@ -1,0 +1,443 @@
+//! Broad phase: which pairs can touch within a step. A hierarchy of uniform
+//! grids: the first level's cell is sized for the bulk of the spheres (the
+//! 98th percentile of their reach); the ones that do not fit go up to a
+//! coarser level sized the same way among themselves, and so on, and the last
+//! handful are tested against everything. A sphere of a coarse level meets
+//! the finer levels by querying their cells over its own reach, so radii or
+//! speeds spread over orders of magnitude stay about linear in cost. Tiny
+//! scenes use all pairs.
+mod level;
+
+use super::exec::{Exec, for_each_block, for_each_chunk};
+use super::sphere::Sphere;
+use glam::DVec3;
+use level::{Ball, Entry, Level, within};
+use parking_lot::Mutex;
+use std::cell::Cell;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// At most this many spheres are tested against everything.
+const ALL_PAIRS_MAX: usize = 24;
+/// Coarse-level spheres per parallel block of cross-level queries.
+const CROSS_BLOCK: usize = 64;
+/// Fewer spheres than this are sorted into the first level on one lane.
+const LANES_MIN_SPHERES: usize = 4096;
+/// Spheres per parallel block while binning.
+const BUILD_BLOCK: usize = 4096;
+/// Pairs a unit of [`Grid::pairs_within`] finds before it adds them to the
+/// shared total.
+const LIMIT_FLUSH: usize = 256;
+/// The first level's cell comes from every this-many-th reach.
+const SAMPLE_STRIDE: usize = 32;
+
+/// A pair that may touch: sphere indices, `i < j` not implied.
+pub type Pair = (u32, u32);
+#[derive(Default)]
+pub struct Grid {
+    levels: Vec<Level>,
+    /// The last few, tested against everything.
+    top: Vec<(Ball, u32)>,
+    staged: Vec<Entry>,
+    /// The box's side, as of the last build.
+    size: f64,
+    /// Spheres not yet placed in a level: (ball, id).
+    rest: Vec<(Ball, u32)>,
+    scratch: Vec<f64>,
+    /// Per block of spheres, the balls too wide for the first level (found
+    /// in parallel, joined in block order).
+    wide: Vec<Mutex<Vec<(Ball, u32)>>>,
+    slots: Vec<Mutex<Vec<Pair>>>,
+}
+/// Twice the 98th percentile of `reach` (estimated on every `stride`-th
+/// value: a function of the state only, so the grid, and the order pairs
+/// come out in, never depend on history), or twice `max` when the fastest is
+/// close to the bulk.
+fn cell_for(
+    reaches: impl Iterator<Item = f64>,
+    max: f64,
+    stride: usize,
+    scratch: &mut Vec<f64>,
+) -> f64 {
+    scratch.clear();
+    scratch.extend(reaches.step_by(stride));
+    cell_of_sample(scratch, max)
+}
+
+/// [`cell_for`] of reaches already sampled into `scratch` (reordered);
+/// `max` is the widest reach known (for the first level, the sample's: a
+/// sphere wider than the cell then goes up a level, as any would).
+fn cell_of_sample(scratch: &mut [f64], max: f64) -> f64 {
+    if scratch.is_empty() {
+        return 2.0 * max;
+    }
+    let k = (scratch.len() * 98 / 100).min(scratch.len() - 1);
+    let q = *scratch.select_nth_unstable_by(k, f64::total_cmp).1;
+    // When the fastest is close to the bulk, one level holds everyone.
+    2.0 * if max <= 1.25 * q { max } else { q }
+}
+/// The work units of `pairs`, in the fixed order their results are joined.
+#[derive(Clone, Copy)]
+enum Unit {
+    /// Same-level pairs of one key block of a level.
+    Block { level: usize, block: usize },
+    /// Spheres `from..to` of a coarse level against every finer level.
+    Cross {
+        level: usize,
+        from: usize,
+        to: usize,
+    },
+    /// The last few against everything.
+    Top,
+}
+
+impl Grid {
+    /// Bin the spheres. `ball(s)` is a centre and a reach: during the step
+    /// the sphere stays inside that ball, so a pair matters only when the
+    /// distance of the centres is at most the sum of the reaches. The
+    /// per-sphere arithmetic of the first level runs on `exec`.
+    pub fn build(
+        &mut self,
+        spheres: &[Sphere],
+        size: f64,
+        ball: impl Fn(&Sphere) -> (DVec3, f64) + Sync,
+        exec: &dyn Exec,
+    ) {
+        let n = spheres.len();
+        self.size = size;
+        self.top.clear();
+        let mut depth = 0;
+        if n > ALL_PAIRS_MAX {
+            if self.levels.is_empty() {
+                self.levels.push(Level::default());
+            }
+            // The first level's cell comes from a sample of the reaches (a
+            // function of the state only, so the grid, and the order pairs
+            // come out in, never depend on history); then each sphere's
+            // ball and key are made in one pass over the spheres.
+            self.scratch.clear();
+            self.scratch
+                .extend(spheres.iter().step_by(SAMPLE_STRIDE).map(|s| ball(s).1));
+            let max = self.scratch.iter().fold(0.0f64, |m, &r| m.max(r));
+            let want = cell_of_sample(&mut self.scratch, max);
+            let level = &mut self.levels[0];
+            level.shape(size, want, n, true);
+            self.staged.resize(n, Entry::default());
+            self.rest.clear();
+            // Under this many spheres, waking other threads costs more than
+            // the sort; the layout is the same for any number of lanes.
+            if n < LANES_MIN_SPHERES || exec.lanes() <= 1 {
+                // One lane: the cells are counted while staging, so the
+                // table's increments overlap the arithmetic of the balls
+                // and the staged records are read once less.
+                level.cell_start.fill(0);
+                let (mut count, mut reach_max) = (0, 0.0f64);
+                for ((slot, s), id) in self.staged.iter_mut().zip(spheres).zip(0..) {
+                    *slot = level.stage(ball(s), id, &mut self.rest);
+                    if slot.key != u32::MAX {
+                        level.cell_start[slot.key as usize] += 1;
+                        count += 1;
+                        // Not `f64::max`: see `fill_lanes`.
+                        if slot.ball.reach > reach_max {
+                            reach_max = slot.ball.reach;
+                        }
+                    }
+                }
+                level.fill_lanes(&self.staged, exec, Some((count, reach_max)));
+            } else {
+                let blocks = n.div_ceil(BUILD_BLOCK);
+                self.wide.resize_with(blocks, Default::default);
+                let level = &*level;
+                let wide = &self.wide;
+                for_each_chunk(exec, &mut self.staged, BUILD_BLOCK, &|b, chunk| {
+                    let mut wide = wide[b].lock();
+                    wide.clear();
+                    let first = (b * BUILD_BLOCK) as u32;
+                    let mine = chunk.iter_mut().zip(&spheres[b * BUILD_BLOCK..]);
+                    for ((slot, s), id) in mine.zip(first..) {
+                        *slot = level.stage(ball(s), id, &mut wide);
+                    }
+                });
+                self.levels[0].fill_lanes(&self.staged, exec, None);
+                for w in &self.wide[..blocks] {
+                    self.rest.extend_from_slice(&w.lock());
+                }
+            }
+            depth = 1;
+            // Coarser levels for what did not fit, serially: they are few.
+            while self.rest.len() > ALL_PAIRS_MAX {
+                if self.levels.len() == depth {
+                    self.levels.push(Level::default());
+                }
+                let max = self.rest.iter().fold(0.0f64, |m, b| m.max(b.0.reach));
+                let want = cell_for(
+                    self.rest.iter().map(|b| b.0.reach),
+                    max,
+                    1,
+                    &mut self.scratch,
+                );
+                let level = &mut self.levels[depth];
+                level.shape(size, want, self.rest.len(), false);
+                let placed: Vec<Entry> = self
+                    .rest
+                    .iter()
+                    .filter(|b| level.fits(b.0.reach))
+                    .map(|&(ball, id)| Entry {
+                        ball,
+                        id,
+                        key: level.key_of(ball.pos),
+                    })
+                    .collect();
+                if placed.is_empty() {
+                    // Balls wider than a one-cell level (the whole box) fit
+                    // no coarser level either: they join the top, tested
+                    // against everything. Without this the loop never ends.
+                    break;
+                }
+                level.fill(&placed);
+                let cell = level.cell;
+                self.rest.retain(|b| 2.0 * b.0.reach > cell);
+                depth += 1;
+            }
+            self.top.extend_from_slice(&self.rest);
+        } else {
+            self.top.extend(spheres.iter().zip(0..).map(|(s, i)| {
+                let (pos, reach) = ball(s);
+                (Ball { pos, reach }, i)
+            }));
+        }
+        self.levels.truncate(depth);
+    }
+
+    fn units(&self) -> Vec<Unit> {
+        let mut units = Vec::new();
+        for (l, level) in self.levels.iter().enumerate() {
+            units.extend((0..level.key_blocks()).map(|block| Unit::Block { level: l, block }));
+            if l > 0 {
+                let n = level.entries.len() - 1;
+                units.extend((0..n.div_ceil(CROSS_BLOCK)).map(|b| Unit::Cross {
+                    level: l,
+                    from: b * CROSS_BLOCK,
+                    to: ((b + 1) * CROSS_BLOCK).min(n),
+                }));
+            }
+        }
+        if !self.top.is_empty() {
+            units.push(Unit::Top);
+        }
+        units
+    }
+
+    /// The pairs of one unit within reach, as `f(id, id)`; `go` is asked
+    /// before each sphere's pairs, and the unit stops when it says no.
+    fn unit_pairs(&self, unit: Unit, go: &impl Fn() -> bool, f: &mut impl FnMut(u32, u32)) {
+        match unit {
+            Unit::Block { level, block } => self.levels[level].block_pairs(block, go, f),
+            Unit::Cross { level, from, to } => {
+                let coarse = &self.levels[level];
+                for e in &coarse.entries[from..to] {
+                    if !go() {
+                        return;
+                    }
+                    let (a, ia) = (&e.ball, e.id);
+                    for finer in &self.levels[..level] {
+                        finer.near(a.pos, a.reach + finer.reach_max, &mut |j| {
+                            let b = &finer.entries[j];
+                            if within(a, &b.ball) {
+                                f(ia, b.id);
+                            }
+                        });
+                    }
+                }
+            }
+            Unit::Top => {
+                for (k, (a, ia)) in self.top.iter().enumerate() {
+                    if !go() {
+                        return;
+                    }
+                    for level in &self.levels {
+                        level.near(a.pos, a.reach + level.reach_max, &mut |j| {
+                            let b = &level.entries[j];
+                            if within(a, &b.ball) {
+                                f(*ia, b.id);
+                            }
+                        });
+                    }
+                    for (b, ib) in &self.top[k + 1..] {
+                        if within(a, b) {
+                            f(*ia, *ib);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Every pair within reach, in a fixed order, found in parallel on
+    /// `exec`; `keep` filters pairs.
+    pub fn pairs<K: Fn(u32, u32) -> bool + Sync>(
+        &mut self,
+        exec: &dyn Exec,
+        keep: &K,
+        out: &mut Vec<Pair>,
+    ) {
+        out.clear();
+        let units = self.units();
+        while self.slots.len() < units.len() {
+            self.slots.push(Mutex::new(Vec::new()));
+        }
+        let this = &*self;
+        for_each_block(exec, units.len(), &|u| {
+            let mut v = this.slots[u].lock();
+            v.clear();
+            this.unit_pairs(units[u], &|| true, &mut |i, j| {
+                if keep(i, j) {
+                    v.push((i, j));
+                }
+            });
+        });
+        for s in &self.slots[..units.len()] {
+            out.extend_from_slice(&s.lock());
+        }
+    }
+
+    /// As [`Grid::pairs`], but stops once more than `limit` pairs are
+    /// found (a step's work budget); returns false then, with only some of
+    /// them in `out`. Every unit runs to its end unless the running total
+    /// is over `limit`, so the answer is "the pairs number more than
+    /// `limit`", whatever the lanes and their timing.
+    pub fn pairs_within<K: Fn(u32, u32) -> bool + Sync>(
+        &mut self,
+        exec: &dyn Exec,
+        keep: &K,
+        out: &mut Vec<Pair>,
+        limit: usize,
+    ) -> bool {
+        if limit == usize::MAX {
+            self.pairs(exec, keep, out);
+            return true;
+        }
+        out.clear();
+        let units = self.units();
+        while self.slots.len() < units.len() {
+            self.slots.push(Mutex::new(Vec::new()));
+        }
+        let this = &*self;
+        let found = AtomicUsize::new(0);
+        for_each_block(exec, units.len(), &|u| {
+            let mut v = this.slots[u].lock();
+            v.clear();
+            // Counted here, added to the total now and then: one shared
+            // counter touched per pair would cost more than the pair.
+            // The total is read then too: a unit that finds few pairs costs
+            // little, whatever the others found.
+            let (mine, told, over) = (Cell::new(0usize), Cell::new(0usize), Cell::new(false));
+            let tell = || {
+                let new = mine.get() - told.get();
+                let before = found.fetch_add(new, Ordering::Relaxed);
+                told.set(mine.get());
+                over.set(before + new > limit);
+            };
+            let go = || {
+                if mine.get() - told.get() >= LIMIT_FLUSH {
+                    tell();
+                }
+                !over.get()
+            };
+            over.set(found.load(Ordering::Relaxed) > limit);
+            if go() {
+                this.unit_pairs(units[u], &go, &mut |i, j| {
+                    if keep(i, j) {
+                        v.push((i, j));
+                        mine.set(mine.get() + 1);
+                    }
+                });
+            }
+            tell();
+        });
+        if found.into_inner() > limit {
+            return false;
+        }
+        for s in &self.slots[..units.len()] {
+            out.extend_from_slice(&s.lock());
+        }
+        true
+    }
+
+    /// Every sphere whose ball may meet a ball of radius `reach` around `p`,
+    /// as `f(id, centre, reach as binned)`, the caller applying its own test.
+    /// `grow`: found too are balls that have since grown up to `grow` times
+    /// their level's widest (see [`Grid::widest_in_level`]); 1 for balls as
+    /// binned. Swept's runs grow balls as paths turn and pick the factor.
+    pub fn near(&self, p: DVec3, reach: f64, grow: f64, f: &mut impl FnMut(u32, DVec3, f64)) {
+        for level in &self.levels {
+            level.near(p, reach + grow * level.reach_max, &mut |j| {
+                let e = &level.entries[j];
+                f(e.id, e.ball.pos, e.ball.reach);
+            });
+        }
+        for (b, id) in &self.top {
+            f(*id, b.pos, b.reach);
+        }
+    }
+
+    /// Every sphere whose ball reaches a face of the box the grid was built
+    /// for, as `f(id)`, in no particular order. Only the cells on the faces
+    /// and the last few are looked at: a ball is at most half a cell wide,
+    /// so from any other cell it stays over half a cell inside.
+    pub fn near_faces(&self, f: &mut impl FnMut(u32)) {
+        let size = self.size;
+        let out = |b: &Ball| {
+            (b.pos.min_element() - b.reach <= 0.0) | (b.pos.max_element() + b.reach >= size)
+        };
+        for level in &self.levels {
+            level.on_faces(&mut |j| {
+                // The balls lie in cell order, so this test reads memory in
+                // order; the caller's test, for the few that pass, does not.
+                let e = &level.entries[j];
+                if out(&e.ball) {
+                    f(e.id);
+                }
+            });
+        }
+        for (b, id) in &self.top {
+            if out(b) {
+                f(*id);
+            }
+        }
+    }
+
+    /// The widest ball of the level a ball of `reach` is binned in (infinite
+    /// for the last few, which every search visits whatever their reach).
+    #[must_use]
+    pub fn widest_in_level(&self, reach: f64) -> f64 {
+        self.levels
+            .iter()
+            .find(|l| l.fits(reach))
+            .map_or(f64::INFINITY, |l| l.reach_max)
+    }
+
+    /// Cells per side of each level, and how many spheres each holds (the
+    /// last number: tested against everything). For diagnostics.
+    #[must_use]
+    pub fn shape(&self) -> (Vec<(usize, usize)>, usize) {
+        (
+            self.levels
+                .iter()
+                .map(|l| (l.per_side, l.entries.len().saturating_sub(1)))
+                .collect(),
+            self.top.len(),
+        )
+    }
+}
+
+/// Calls `f(i, j)` once for every pair whose spheres touch or overlap
+/// (centres within the sum of radii). Serial; for checks and placement.
+pub fn for_each_near_pair(spheres: &[Sphere], size: f64, mut f: impl FnMut(usize, usize)) {
+    let mut grid = Grid::default();
+    grid.build(spheres, size, |s| (s.pos, s.radius), &super::exec::Serial);
+    let mut out = Vec::new();
+    grid.pairs(&super::exec::Serial, &|_: u32, _: u32| true, &mut out);
+    for (i, j) in out {
+        f(i as usize, j as usize);
+    }
+}

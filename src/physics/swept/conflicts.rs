@@ -1,0 +1,297 @@
+//! Whether clusters that ran apart really kept apart. The runs' paths are
+//! kept by slot, as turns; pairs in different clusters whose balls met
+//! (noted by a run, or grown balls found by a grid over all of them) are
+//! compared turn by turn, and those that come within touching distance are
+//! conflicts: their clusters merge and run again.
+use super::cluster::{Coarse, Member, Turn};
+use super::partition::{Partition, Slot};
+use super::path_ball;
+use super::rounds::RoundStats;
+use crate::physics::broad::Grid;
+use crate::physics::exec::{Exec, Serial};
+use crate::physics::sphere::Sphere;
+use glam::DVec3;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Fewer grown balls than this are compared on one lane.
+const LANES_MIN_BALLS: usize = 2048;
+
+/// By slot, what the cluster's last finished run left.
+#[derive(Default)]
+pub(super) struct Finished {
+    /// The member's end of the step and path (None until its cluster ran).
+    pub out: Vec<Option<Member>>,
+    /// Whether (and why) that run was capped.
+    pub capped: Vec<Option<Coarse>>,
+    /// The round that run was made in (NONE before any).
+    pub ran: Vec<u32>,
+    /// Every finished member's turns (`Member::turn0` indexes here).
+    pub turns: Vec<Turn>,
+}
+
+impl Finished {
+    pub fn reset(&mut self, m: usize) {
+        self.out.clear();
+        self.out.resize(m, None);
+        self.capped.clear();
+        self.capped.resize(m, None);
+        self.ran.clear();
+        self.ran.resize(m, super::NONE);
+        self.turns.clear();
+    }
+
+    /// Room for a slot added after the first round.
+    pub fn push(&mut self) {
+        self.out.push(None);
+        self.capped.push(None);
+        self.ran.push(super::NONE);
+    }
+
+    /// Whether the spheres of slots `a` and `b` come within touching
+    /// distance during the step. A path not fully known (a capped run's,
+    /// or one not run) meets everyone: a merge costs time, never a result.
+    fn meet(&self, a: usize, b: usize, spheres: &[Sphere], dt: f64) -> bool {
+        let path = |s: usize| {
+            let m = self.out[s].filter(|_| self.capped[s].is_none())?;
+            let turns = &self.turns[m.turn0 as usize..(m.turn0 + m.turns) as usize];
+            Some((&spheres[m.id as usize], turns))
+        };
+        let (Some((sa, ta)), Some((sb, tb))) = (path(a), path(b)) else {
+            return true;
+        };
+        paths_meet(sa, ta, sb, tb, dt)
+    }
+
+    /// The ball slot `s` (sphere `id`) stays in: from its last finished
+    /// run, or its straight path.
+    fn ball(&self, s: usize, id: u32, spheres: &[Sphere], dt: f64) -> (DVec3, f64) {
+        match &self.out[s] {
+            Some(m) => (m.centre, m.reach),
+            None => path_ball(&spheres[id as usize], dt),
+        }
+    }
+}
+
+/// The conflicts of a round, and what finds them.
+#[derive(Default)]
+pub(super) struct Conflicts {
+    /// Pairs of spheres whose clusters must merge and run again.
+    pub found: Vec<(u32, u32)>,
+    /// (sphere, sphere of another cluster) whose balls met in a standing
+    /// run: their paths are compared once the runs agree.
+    pub cross: Vec<(u32, u32)>,
+    /// Scratch of the grown-ball check: every slot's ball, a grid over
+    /// them, the pairs it found, each slot's cluster.
+    balls: Vec<Sphere>,
+    overlap: Grid,
+    overlap_pairs: Vec<(u32, u32)>,
+    cluster_of: Vec<Slot>,
+}
+
+impl Conflicts {
+    /// Pairs of spheres in different clusters whose balls met during a run
+    /// conflict if their paths really come within touching distance.
+    pub fn check_cross(
+        &mut self,
+        part: &mut Partition,
+        fin: &Finished,
+        spheres: &[Sphere],
+        dt: f64,
+        stats: &mut RoundStats,
+    ) {
+        for &(a, b) in &self.cross {
+            let (sa, sb) = (part.slot[a as usize], part.slot[b as usize]);
+            if part.find(sa) == part.find(sb) {
+                continue;
+            }
+            stats.compared += 1;
+            if fin.meet(sa.index(), sb.index(), spheres, dt) {
+                self.found
+                    .push((part.ids[sa.index()], part.ids[sb.index()]));
+            } else {
+                stats.apart += 1;
+            }
+        }
+    }
+
+    /// A finished cluster whose member's ball grew was checked against the
+    /// balls the grid holds, of spheres that had events then. Two such
+    /// grown balls, or any ball and that of a bystander that joined a run (which
+    /// other runs took to fly straight), may meet where no run could see
+    /// it: such pairs in different clusters are compared by their paths.
+    #[allow(clippy::too_many_arguments)]
+    pub fn check_grown(
+        &mut self,
+        exec: &dyn Exec,
+        part: &mut Partition,
+        fin: &Finished,
+        spheres: &[Sphere],
+        size: f64,
+        dt: f64,
+        stats: &mut RoundStats,
+    ) {
+        let m = part.ids.len();
+        let any_changed = m > part.first_late || fin.out.iter().any(|o| o.is_some_and(|o| o.grew));
+        if !any_changed || m < 2 {
+            return;
+        }
+        // Every slot's ball, indexed by slot.
+        self.balls.clear();
+        for s in 0..m {
+            let (centre, reach) = fin.ball(s, part.ids[s], spheres, dt);
+            self.balls.push(Sphere {
+                pos: centre,
+                vel: DVec3::ZERO,
+                radius: reach,
+                mass: 0.0,
+            });
+        }
+        // Merges since the round began joined clusters: name them afresh.
+        self.cluster_of.clear();
+        self.cluster_of
+            .extend((0..m).map(|s| part.find(Slot::at(s))));
+        self.overlap.build(
+            &self.balls,
+            size,
+            |b| (b.pos, b.radius),
+            small(exec, self.balls.len()),
+        );
+        let mut pairs = std::mem::take(&mut self.overlap_pairs);
+        let cluster_of = &self.cluster_of;
+        let compared = AtomicUsize::new(0);
+        let first_late = part.first_late;
+        let changed = |s: usize| s >= first_late || fin.out[s].is_some_and(|o| o.grew);
+        // The paths are compared in the pair search, on its lanes.
+        let meet = |a: u32, b: u32| {
+            let (sa, sb) = (a as usize, b as usize);
+            if !(changed(sa) || changed(sb)) || cluster_of[sa] == cluster_of[sb] {
+                return false;
+            }
+            compared.fetch_add(1, Ordering::Relaxed);
+            fin.meet(sa, sb, spheres, dt)
+        };
+        self.overlap
+            .pairs(small(exec, self.balls.len()), &meet, &mut pairs);
+        let compared = compared.into_inner();
+        stats.compared += compared;
+        stats.apart += compared - pairs.len();
+        for &(a, b) in &pairs {
+            self.found
+                .push((part.ids[a as usize], part.ids[b as usize]));
+        }
+        self.overlap_pairs = pairs;
+    }
+}
+
+/// `exec`, or the calling thread when `n` items are too few to be worth
+/// handing to other threads (each hand-off costs tens of microseconds).
+fn small(exec: &dyn Exec, n: usize) -> &dyn Exec {
+    if n < LANES_MIN_BALLS { &Serial } else { exec }
+}
+
+/// Relative margin on the touching distance when comparing two paths: far
+/// above the rounding of positions (about 1e-16 of the box), so a pair the
+/// serial loop would see touch is never passed as apart.
+const PATH_MARGIN: f64 = 1e-8;
+
+/// Whether two spheres, from `a` and `b` at the start of the step and
+/// turning as `ta` and `tb` say (time order), come within the sum of their
+/// radii (widened by [`PATH_MARGIN`]) at one moment of `0..=dt`: on each
+/// stretch where both fly straight, the closest approach of the two lines.
+fn paths_meet(a: &Sphere, ta: &[Turn], b: &Sphere, tb: &[Turn], dt: f64) -> bool {
+    let sigma = (a.radius + b.radius) * (1.0 + PATH_MARGIN);
+    let start = |s: &Sphere| Turn {
+        t: 0.0,
+        pos: s.pos,
+        vel: s.vel,
+    };
+    let (mut ka, mut kb) = (start(a), start(b));
+    let (mut ia, mut ib) = (0, 0);
+    let mut t0 = 0.0;
+    loop {
+        let next = |turns: &[Turn], i: usize| turns.get(i).map_or(dt, |k| k.t.min(dt));
+        let t1 = next(ta, ia).min(next(tb, ib));
+        let dp = (ka.pos + ka.vel * (t0 - ka.t)) - (kb.pos + kb.vel * (t0 - kb.t));
+        let dv = ka.vel - kb.vel;
+        let vv = dv.length_squared();
+        let s = if vv > 0.0 {
+            (-dp.dot(dv) / vv).clamp(0.0, t1 - t0)
+        } else {
+            0.0
+        };
+        if (dp + dv * s).length_squared() <= sigma * sigma {
+            return true;
+        }
+        if t1 >= dt {
+            return false;
+        }
+        while ia < ta.len() && ta[ia].t <= t1 {
+            ka = ta[ia];
+            ia += 1;
+        }
+        while ib < tb.len() && tb[ib].t <= t1 {
+            kb = tb[ib];
+            ib += 1;
+        }
+        t0 = t1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sphere(pos: [f64; 3], vel: [f64; 3]) -> Sphere {
+        Sphere {
+            pos: DVec3::from(pos),
+            vel: DVec3::from(vel),
+            radius: 0.1,
+            mass: 1.0,
+        }
+    }
+
+    fn turn(t: f64, pos: [f64; 3], vel: [f64; 3]) -> Turn {
+        Turn {
+            t,
+            pos: DVec3::from(pos),
+            vel: DVec3::from(vel),
+        }
+    }
+
+    #[test]
+    fn crossing_lines_meet_only_at_the_same_time() {
+        // Both pass through the origin: at t = 1 together, or a second apart.
+        let a = sphere([-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
+        let together = sphere([0.0, -1.0, 0.0], [0.0, 1.0, 0.0]);
+        let late = sphere([0.0, -2.0, 0.0], [0.0, 1.0, 0.0]);
+        assert!(paths_meet(&a, &[], &together, &[], 2.0));
+        assert!(!paths_meet(&a, &[], &late, &[], 2.0));
+        // Closest approach after the step ends does not count.
+        assert!(!paths_meet(&a, &[], &together, &[], 0.5));
+        // Just outside and just inside touching distance (0.2).
+        let by = |gap: f64| sphere([0.0, gap, 0.0], [1.0, 0.0, 0.0]);
+        let still = sphere([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
+        assert!(!paths_meet(&still, &[], &by(0.2 * (1.0 + 1e-6)), &[], 1.0));
+        assert!(paths_meet(&still, &[], &by(0.2 * (1.0 - 1e-6)), &[], 1.0));
+    }
+
+    #[test]
+    fn a_turn_decides_whether_paths_meet() {
+        // `b` waits at (0, 1, 0). `a` heads along x; turned up at t = 1 (at
+        // the origin) it touches `b` at t = 1.8; turned down it never does,
+        // and straight it passes 1 away.
+        let a = sphere([-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
+        let b = sphere([0.0, 1.0, 0.0], [0.0, 0.0, 0.0]);
+        let up = [turn(1.0, [0.0, 0.0, 0.0], [0.0, 1.0, 0.0])];
+        let down = [turn(1.0, [0.0, 0.0, 0.0], [0.0, -1.0, 0.0])];
+        assert!(!paths_meet(&a, &[], &b, &[], 3.0));
+        assert!(paths_meet(&a, &up, &b, &[], 3.0));
+        assert!(paths_meet(&b, &[], &a, &up, 3.0), "either order");
+        assert!(!paths_meet(&a, &down, &b, &[], 3.0));
+        // The meeting at t = 1.8 lies past a step of 1.5.
+        assert!(!paths_meet(&a, &up, &b, &[], 1.5));
+        // Both turn: `b` runs off along +y at t = 0.5 and stays ahead.
+        let away = [turn(0.5, [0.0, 1.0, 0.0], [0.0, 2.0, 0.0])];
+        assert!(!paths_meet(&a, &up, &b, &away, 3.0));
+    }
+}
