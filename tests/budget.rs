@@ -3,10 +3,13 @@
 //! bounded time, finished in free flight and reported; a capped step is the
 //! same bits on any lanes; a step under its budget is untouched by it.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+#[path = "common/bits.rs"]
+mod bits;
 use ballpit::engine::{PoolExec, SplitExec};
 use ballpit::physics::swept::Swept;
 use ballpit::physics::{Exec, Model, Serial, Sphere, World};
 use ballpit::scene::{SceneSpec, build_world};
+use bits::bits;
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -130,24 +133,6 @@ fn gas(count: usize, speed: f64) -> World {
         ..Default::default()
     })
     .unwrap()
-}
-
-/// Every number of the state, as bits.
-fn bits(w: &World) -> Vec<u64> {
-    let c = &w.counters;
-    let mut v = vec![
-        w.time.to_bits(),
-        c.sphere_collisions,
-        c.wall_collisions,
-        c.wall_momentum.to_bits(),
-        c.capped_steps,
-        c.budget_steps,
-    ];
-    for s in &w.spheres {
-        v.extend(s.pos.to_array().map(f64::to_bits));
-        v.extend(s.vel.to_array().map(f64::to_bits));
-    }
-    v
 }
 
 fn inside(w: &World) -> bool {

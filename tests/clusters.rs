@@ -2,25 +2,12 @@
 //! result must be the plain serial event loop's, bit for bit, on every kind
 //! of scene, however many lanes run the clusters.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+#[path = "common/bits.rs"]
+mod bits;
 use ballpit::physics::swept::Swept;
-use ballpit::physics::{Exec, Model, Serial, World};
+use ballpit::physics::{Model, Serial, World};
 use ballpit::scene::{SceneSpec, build_world};
-
-/// Lanes run one after another, last first.
-struct Lanes(usize);
-
-impl Exec for Lanes {
-    fn lanes(&self) -> usize {
-        self.0
-    }
-    fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
-        (0..self.0).rev().for_each(f);
-    }
-    fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {
-        b();
-        a();
-    }
-}
+use bits::Lanes;
 
 fn world(scene: &str, count: usize, speed: Option<f64>) -> World {
     build_world(&SceneSpec {

@@ -2,8 +2,11 @@
 //! nothing, the idle physics thread sleeps, panics come back as errors, and
 //! count and radius edits keep spheres apart and inside.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+#[path = "common/bits.rs"]
+mod bits;
 use ballpit::engine::{Command, Engine, Settings, Threading};
 use ballpit::physics::{Exec, Model, ModelKind, Sphere, World};
+use bits::bits;
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -59,24 +62,6 @@ fn run(world: &World, s: Settings, frames: usize) -> World {
         e.finish_frame().unwrap();
     }
     e.world().clone()
-}
-
-/// Every number of the state, as bits.
-fn bits(w: &World) -> Vec<u64> {
-    let mut v = vec![
-        w.time.to_bits(),
-        w.counters.sphere_collisions,
-        w.counters.wall_collisions,
-        w.counters.wall_momentum.to_bits(),
-        w.counters.capped_steps,
-    ];
-    for s in &w.spheres {
-        v.extend(s.pos.to_array().map(f64::to_bits));
-        v.extend(s.vel.to_array().map(f64::to_bits));
-        v.push(s.radius.to_bits());
-        v.push(s.mass.to_bits());
-    }
-    v
 }
 
 fn modes() -> Vec<(Threading, usize)> {

@@ -2,8 +2,11 @@
 //! the same figures and the same world as one with a screen, Reset brings
 //! back the start bit for bit, and the screen's single-precision views stay
 //! within rounding of the world.
+#[path = "common/bits.rs"]
+mod bits;
 use ballpit::engine::{Command, Engine, Settings, Snapshot, Threading};
 use ballpit::physics::{ModelKind, Sphere, World};
+use bits::bits;
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -37,24 +40,6 @@ fn settings(model: ModelKind, threading: Threading) -> Settings {
         threading,
         threads: 2,
     }
-}
-
-/// Every number of the state, as bits.
-fn bits(w: &World) -> Vec<u64> {
-    let mut v = vec![
-        w.size.to_bits(),
-        w.time.to_bits(),
-        w.counters.sphere_collisions,
-        w.counters.wall_collisions,
-        w.counters.wall_momentum.to_bits(),
-        w.counters.capped_steps,
-    ];
-    for s in &w.spheres {
-        v.extend(s.pos.to_array().map(f64::to_bits));
-        v.extend(s.vel.to_array().map(f64::to_bits));
-        v.extend([s.radius.to_bits(), s.mass.to_bits()]);
-    }
-    v
 }
 
 /// The figures a snapshot reports, as bits (everything but the views and

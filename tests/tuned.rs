@@ -1,10 +1,13 @@
 //! The tuned constants of `swept` were chosen on the bench presets; here
 //! they are held on scenes that are not presets.
+#[path = "common/bits.rs"]
+mod bits;
 use ballpit::physics::broad::Grid;
 use ballpit::physics::sphere::{Sphere, volume};
 use ballpit::physics::swept::{ADDED_PAIRS, Swept};
-use ballpit::physics::{Exec, Model, Serial, World};
+use ballpit::physics::{Model, Serial, World};
 use ballpit::scene::{SceneSpec, build_world};
+use bits::Lanes;
 use proptest::prelude::*;
 
 const DT: f64 = 1.0 / 60.0;
@@ -72,22 +75,6 @@ proptest! {
         prop_assert_eq!(after.escaped(), 0);
         let (e0, e1) = (w.kinetic_energy(), after.kinetic_energy());
         prop_assert!((e1 - e0).abs() <= 1e-12 * e0);
-    }
-}
-
-/// Lanes run one after another, last first.
-struct Lanes(usize);
-
-impl Exec for Lanes {
-    fn lanes(&self) -> usize {
-        self.0
-    }
-    fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
-        (0..self.0).rev().for_each(f);
-    }
-    fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {
-        b();
-        a();
     }
 }
 
