@@ -46,7 +46,9 @@ pub fn parse_with(
         );
     }
     let mut spheres = Vec::new();
-    let mut lines = Vec::new();
+    // Where each record starts; its line is counted only for a message (a
+    // count per record would make loading quadratic in the file's size).
+    let mut starts = Vec::new();
     // Lines counted from the bytes, not by the reader, so CRLF files count
     // like LF ones (a record's position may be the `\n` ending the last).
     let line_at = |byte: u64| {
@@ -62,15 +64,21 @@ pub fn parse_with(
             let line = e.position().map_or(0, |p| line_at(p.byte()));
             bad_input!("{name} line {line}: {e}")
         })?;
-        let line = rec.position().map_or(0, |p| line_at(p.byte()));
+        let start = rec.position().map_or(0, csv::Position::byte);
+        let line = || line_at(start);
         if rec.len() != 8 {
-            return bad!("{name} line {line}: expected 8 fields, found {}", rec.len());
+            return bad!(
+                "{name} line {}: expected 8 fields, found {}",
+                line(),
+                rec.len()
+            );
         }
         let mut v = [0.0; 8];
         for (k, (slot, field)) in v.iter_mut().zip(rec.iter()).enumerate() {
             *slot = field.parse().map_err(|_| {
                 bad_input!(
-                    "{name} line {line}: {} = `{field}` is not a number",
+                    "{name} line {}: {} = `{field}` is not a number",
+                    line(),
                     HEADER[k]
                 )
             })?;
@@ -81,10 +89,12 @@ pub fn parse_with(
             radius: v[6],
             mass: v[7],
         });
-        lines.push(line);
+        starts.push(start);
     }
     let world = World::new(size, spheres);
-    check_with(&world, overlaps, name, &|i| format!("line {}", lines[i]))?;
+    check_with(&world, overlaps, name, &|i| {
+        format!("line {}", line_at(starts[i]))
+    })?;
     Ok(world)
 }
 
