@@ -11,7 +11,7 @@ pub struct ThreadCpu {
 
 /// The fields of docs/design.md's bench JSON, plus `physics_threads`,
 /// `load_average`, `collisions_per_sim_second`, `temperature` and
-/// `capped_steps` (and `budget_steps`, those of them `swept`'s work budget
+/// `capped_steps` (and `budget_steps`, those of them a work budget
 /// stopped).
 #[derive(Debug, Serialize)]
 pub struct BenchReport {

@@ -67,7 +67,7 @@ pub const BENCH_FIELDS: &[(&str, &str)] = &[
     ),
     (
         "budget_steps",
-        "of capped_steps, those that ran out of swept's work budget per step",
+        "of capped_steps, those that ran out of a work budget per step (swept's, or discrete's pairs)",
     ),
     (
         "thread_cpu",

@@ -156,28 +156,32 @@ impl Snapshot {
 #[derive(Default)]
 pub(crate) struct OverlapScratch {
     grid: Grid,
-    pairs: Vec<Pair>,
+    /// Stays empty: no pair is kept.
+    none: Vec<Pair>,
 }
 
 impl OverlapScratch {
-    /// Same value as `World::max_overlap_rel`: the max is order-free.
+    /// Same value as `World::max_overlap_rel`: the max is order-free. The
+    /// pairs are looked at, never kept: a heap of overlapping spheres (a
+    /// `discrete` scene from a file) has more of them than memory holds.
     pub(crate) fn max_overlap_rel(&mut self, world: &World, exec: &dyn Exec) -> f64 {
         let sp = &world.spheres;
         self.grid.build(sp, world.size, |s| (s.pos, s.radius), exec);
-        let overlapping = |i: u32, j: u32| {
+        // Depths are never negative, and such f64s order as their bits.
+        let worst = AtomicU64::new(0);
+        let deepest = |i: u32, j: u32| {
             let (a, b) = (&sp[i as usize], &sp[j as usize]);
             let s = a.radius + b.radius;
-            a.pos.distance_squared(b.pos) < s * s
-        };
-        self.grid.pairs(exec, &overlapping, &mut self.pairs);
-        self.pairs.iter().fold(0.0, |worst: f64, &(i, j)| {
-            let (a, b) = (&sp[i as usize], &sp[j as usize]);
-            let depth = a.radius + b.radius - a.pos.distance(b.pos);
-            if depth > 0.0 {
-                worst.max(depth / a.radius.min(b.radius))
-            } else {
-                worst
+            if a.pos.distance_squared(b.pos) < s * s {
+                let depth = s - a.pos.distance(b.pos);
+                if depth > 0.0 {
+                    let rel = depth / a.radius.min(b.radius);
+                    worst.fetch_max(rel.to_bits(), Ordering::Relaxed);
+                }
             }
-        })
+            false
+        };
+        self.grid.pairs(exec, &deepest, &mut self.none);
+        f64::from_bits(worst.into_inner())
     }
 }

@@ -11,6 +11,12 @@ use super::model::{Model, ModelKind};
 use super::sphere::Sphere;
 use super::world::World;
 
+/// Overlapping pairs a step may answer: far more than spheres in contact
+/// ever make (a dozen a sphere), far fewer than a heap of overlapping
+/// spheres from a file (all pairs), whose list would fill the memory.
+const PAIRS_BASE: usize = 20_000_000;
+const PAIRS_PER_SPHERE: usize = 100;
+
 #[derive(Default)]
 pub struct Discrete {
     detect: Detection,
@@ -47,6 +53,7 @@ impl Discrete {
         };
         // Sphere–sphere work (which pairs overlap) beside sphere–wall work
         // (which spheres are past a wall).
+        self.detect.pair_limit = Some(PAIRS_BASE.saturating_add(PAIRS_PER_SPHERE * sp.len()));
         self.detect
             .run(exec, sp, size, |s| (s.pos, s.radius), &overlapping, &|s| {
                 outside(s, size)
@@ -58,6 +65,12 @@ impl Discrete {
             let (imp, hits) = bounce(&mut world.spheres[i as usize], size);
             world.counters.wall_momentum += imp;
             world.counters.wall_collisions += hits;
+        }
+        if self.detect.overran {
+            // Too many to answer: this step answers none of them.
+            world.counters.capped_steps += 1;
+            world.counters.budget_steps += 1;
+            return;
         }
         for &(i, j) in &self.detect.pairs {
             let Ok([a, b]) = world.spheres.get_disjoint_mut([i as usize, j as usize]) else {

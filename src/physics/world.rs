@@ -20,7 +20,7 @@ pub struct Counters {
     /// Steps (or frames, for `exact`) that hit the event cap and were
     /// finished without resolving every contact.
     pub capped_steps: u64,
-    /// Of those, the steps stopped by `swept`'s work budget (the rest hit
+    /// Of those, the steps stopped by a work budget (`swept`, `discrete`; the rest hit
     /// an event cap).
     pub budget_steps: u64,
 }
