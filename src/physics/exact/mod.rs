@@ -44,6 +44,7 @@ pub mod body;
 pub mod cell_grid;
 pub mod large;
 pub mod neighbour_lists;
+mod overlap;
 pub mod queue;
 pub mod renumber;
 pub mod schedule;
@@ -566,5 +567,14 @@ impl<Q: EventQueue + Send> Model for EventDriven<Q> {
 
     fn invalidate(&mut self) {
         self.valid = false;
+    }
+
+    /// From the broad phase the next step uses anyway (see [`overlap`]); a
+    /// world the model does not hold is loaded first, as that step would.
+    fn max_overlap_rel(&mut self, world: &World, _dt: f64, exec: &dyn Exec) -> Option<f64> {
+        if !self.matches(world) {
+            self.load(world);
+        }
+        Some(self.deepest_overlap(exec))
     }
 }

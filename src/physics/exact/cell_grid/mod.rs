@@ -134,6 +134,11 @@ impl CellGrid {
             + self.scan_centre.capacity() * size_of::<DVec3>()
     }
 
+    /// The large spheres (in no cell).
+    pub fn bigs(&self) -> &[u32] {
+        &self.bigs
+    }
+
     #[inline]
     pub fn is_big(&self, i: usize) -> bool {
         self.big_slot[i] != NONE
