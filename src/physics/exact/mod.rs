@@ -1,6 +1,6 @@
 //! `exact`: event-driven hard spheres. Every contact is processed in time
 //! order; between events spheres fly in straight lines. Built the way the
-//! fast hard-sphere codes are (Rapaport; DynamO; Smallenburg's EDMD):
+//! fast hard-sphere codes are (Rapaport; `DynamO`; Smallenburg's EDMD):
 //!
 //! - lazy update: each sphere carries its own time stamp ([`body`]) and is
 //!   moved only when an event touches it or when `advance` returns;
@@ -168,6 +168,7 @@ pub struct EventStats {
 impl<Q: EventQueue> EventDriven<Q> {
     /// Set the events a step may take (default: [`EVENT_CAP_BASE`] plus
     /// [`EVENT_CAP_PER_SPHERE`] per sphere).
+    #[must_use]
     pub fn with_event_cap(mut self, cap: u64) -> Self {
         self.cap = Some(cap);
         self
@@ -175,6 +176,7 @@ impl<Q: EventQueue> EventDriven<Q> {
 
     /// Set the most cells per sphere of the cell grid (default
     /// [`cell_grid::CELLS_PER_SPHERE`]; at least 1), for comparing grids.
+    #[must_use]
     pub fn with_cells_per_sphere(mut self, k: u32) -> Self {
         self.cells_per_sphere = Some(k.max(1));
         self
@@ -182,6 +184,7 @@ impl<Q: EventQueue> EventDriven<Q> {
 
     /// Sort the spheres by cell again as they drift (default: only at
     /// load), for comparing the two.
+    #[must_use]
     pub fn with_renumbering(mut self, on: bool) -> Self {
         self.renumbering = on;
         self

@@ -1,5 +1,5 @@
 //! Broad phase for dilute and moderate scenes: a cell grid with
-//! cell-crossing events (Rapaport; DynamO). Cells are at least the largest
+//! cell-crossing events (Rapaport; `DynamO`). Cells are at least the largest
 //! bulk diameter, so spheres can only touch from neighbouring cells; a
 //! sphere's candidates are the spheres in the 27 cells around its own. A
 //! sphere changes cell only at a crossing event, so the pair bookkeeping is
@@ -173,6 +173,7 @@ impl CellGrid {
             let up = v > 0.0;
             let face = ck + up as u32;
             let t = ((face as f64 * self.cell - b.pos[k]) / v).max(0.0);
+            #[allow(clippy::needless_bitwise_bool)] // branchless on purpose, as above
             let open = (ck != [0, last][up as usize]) & (v != 0.0);
             let t = [f64::INFINITY, t][open as usize];
             let better = t < best;
