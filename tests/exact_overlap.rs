@@ -177,3 +177,24 @@ fn asking_changes_nothing() {
         assert_eq!(ma.stats, mb.stats, "packing {packing}");
     }
 }
+
+/// A world edited after a step (`World::touch`) is read afresh, not taken
+/// for the one the model last wrote.
+#[test]
+fn an_edited_world_is_read_afresh() {
+    let mut w = lattice_world(2000, 0.05, 1.0, 10).unwrap();
+    let mut m = Exact::default();
+    m.advance(&mut w, 1.0 / 60.0, 2, &Serial);
+    assert_eq!(m.max_overlap_rel(&w, 1.0 / 60.0, &Serial), Some(0.0));
+    let (a, b) = (w.spheres[0], w.spheres[1]);
+    w.spheres[1].pos = a.pos + DVec3::X * (a.radius + b.radius) * 0.5;
+    let lo = DVec3::splat(b.radius);
+    w.spheres[1].pos = w.spheres[1].pos.clamp(lo, DVec3::splat(w.size) - lo);
+    w.touch();
+    let want = w.max_overlap_rel();
+    assert!(want > 0.1, "{want}");
+    assert_eq!(
+        m.max_overlap_rel(&w, 1.0 / 60.0, &Serial).map(f64::to_bits),
+        Some(want.to_bits())
+    );
+}

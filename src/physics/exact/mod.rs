@@ -137,6 +137,8 @@ pub struct EventDriven<Q: EventQueue> {
     origin: f64,
     /// World time the bodies were last written back at.
     synced_time: f64,
+    /// `World::generation` of the world they were last written to.
+    synced_generation: u64,
     valid: bool,
     cap: Option<u64>,
     cells_per_sphere: Option<u32>,
@@ -237,6 +239,7 @@ impl<Q: EventQueue> EventDriven<Q> {
         self.size = world.size;
         self.origin = world.time;
         self.synced_time = world.time;
+        self.synced_generation = world.generation();
         self.order = renumber::spatial_order(world.spheres.iter().map(|s| s.pos), world.size);
         self.bodies.clear();
         self.bodies.extend(
@@ -522,6 +525,7 @@ impl<Q: EventQueue> EventDriven<Q> {
             s.vel = b.vel;
         }
         self.synced_time = world.time;
+        self.synced_generation = world.generation();
     }
 }
 
@@ -574,8 +578,15 @@ impl<Q: EventQueue + Send> Model for EventDriven<Q> {
 
     /// From the broad phase the next step uses anyway (see [`overlap`]); a
     /// world the model does not hold is loaded first, as that step would.
+    /// The world last written, not edited since (`World::touch`), is known
+    /// without comparing every sphere.
     fn max_overlap_rel(&mut self, world: &World, _dt: f64, exec: &dyn Exec) -> Option<f64> {
-        if !self.matches(world) {
+        let held = self.valid
+            && world.generation() == self.synced_generation
+            && world.time == self.synced_time
+            && world.size == self.size
+            && world.spheres.len() == self.bodies.len();
+        if !held && !self.matches(world) {
             self.load(world);
         }
         Some(self.deepest_overlap(exec))

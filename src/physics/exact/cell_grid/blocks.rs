@@ -47,6 +47,17 @@ impl CellBlocks {
             + over
     }
 
+    /// Cells, padding included.
+    pub fn cells(&self) -> usize {
+        self.blocks.len()
+    }
+
+    /// Spheres in cell `c`.
+    #[inline]
+    pub fn count(&self, c: usize) -> u32 {
+        self.blocks[c][BLOCK]
+    }
+
     #[inline]
     pub fn cell(&self, i: usize) -> u32 {
         self.at[i].0
