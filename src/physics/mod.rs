@@ -9,16 +9,6 @@ pub mod contact;
 mod detect;
 pub mod discrete;
 pub mod edit;
-#[allow(
-    clippy::doc_markdown,
-    clippy::expect_used,
-    clippy::if_not_else,
-    clippy::missing_panics_doc,
-    clippy::needless_bitwise_bool,
-    clippy::range_plus_one,
-    clippy::return_self_not_must_use,
-    clippy::semicolon_if_nothing_returned
-)]
 pub mod exact;
 pub mod exec;
 pub mod flight;

@@ -1,6 +1,6 @@
 //! `exact`: event-driven hard spheres. Every contact is processed in time
 //! order; between events spheres fly in straight lines. Built the way the
-//! fast hard-sphere codes are (Rapaport; DynamO; Smallenburg's EDMD):
+//! fast hard-sphere codes are (Rapaport; `DynamO`; Smallenburg's EDMD):
 //!
 //! - lazy update: each sphere carries its own time stamp ([`body`]) and is
 //!   moved only when an event touches it or when `advance` returns;
@@ -44,6 +44,7 @@ pub mod body;
 pub mod cell_grid;
 pub mod large;
 pub mod neighbour_lists;
+mod overlap;
 pub mod queue;
 pub mod renumber;
 pub mod schedule;
@@ -136,6 +137,8 @@ pub struct EventDriven<Q: EventQueue> {
     origin: f64,
     /// World time the bodies were last written back at.
     synced_time: f64,
+    /// `World::generation` of the world they were last written to.
+    synced_generation: u64,
     valid: bool,
     cap: Option<u64>,
     cells_per_sphere: Option<u32>,
@@ -167,6 +170,7 @@ pub struct EventStats {
 impl<Q: EventQueue> EventDriven<Q> {
     /// Set the events a step may take (default: [`EVENT_CAP_BASE`] plus
     /// [`EVENT_CAP_PER_SPHERE`] per sphere).
+    #[must_use]
     pub fn with_event_cap(mut self, cap: u64) -> Self {
         self.cap = Some(cap);
         self
@@ -174,6 +178,7 @@ impl<Q: EventQueue> EventDriven<Q> {
 
     /// Set the most cells per sphere of the cell grid (default
     /// [`cell_grid::CELLS_PER_SPHERE`]; at least 1), for comparing grids.
+    #[must_use]
     pub fn with_cells_per_sphere(mut self, k: u32) -> Self {
         self.cells_per_sphere = Some(k.max(1));
         self
@@ -181,6 +186,7 @@ impl<Q: EventQueue> EventDriven<Q> {
 
     /// Sort the spheres by cell again as they drift (default: only at
     /// load), for comparing the two.
+    #[must_use]
     pub fn with_renumbering(mut self, on: bool) -> Self {
         self.renumbering = on;
         self
@@ -233,6 +239,7 @@ impl<Q: EventQueue> EventDriven<Q> {
         self.size = world.size;
         self.origin = world.time;
         self.synced_time = world.time;
+        self.synced_generation = world.generation();
         self.order = renumber::spatial_order(world.spheres.iter().map(|s| s.pos), world.size);
         self.bodies.clear();
         self.bodies.extend(
@@ -518,6 +525,7 @@ impl<Q: EventQueue> EventDriven<Q> {
             s.vel = b.vel;
         }
         self.synced_time = world.time;
+        self.synced_generation = world.generation();
     }
 }
 
@@ -566,5 +574,21 @@ impl<Q: EventQueue + Send> Model for EventDriven<Q> {
 
     fn invalidate(&mut self) {
         self.valid = false;
+    }
+
+    /// From the broad phase the next step uses anyway (see [`overlap`]); a
+    /// world the model does not hold is loaded first, as that step would.
+    /// The world last written, not edited since (`World::touch`), is known
+    /// without comparing every sphere.
+    fn max_overlap_rel(&mut self, world: &World, _dt: f64, exec: &dyn Exec) -> Option<f64> {
+        let held = self.valid
+            && world.generation() == self.synced_generation
+            && world.time == self.synced_time
+            && world.size == self.size
+            && world.spheres.len() == self.bodies.len();
+        if !held && !self.matches(world) {
+            self.load(world);
+        }
+        Some(self.deepest_overlap(exec))
     }
 }

@@ -13,11 +13,15 @@ use std::collections::HashMap;
 /// Spheres a cell's block holds (cells are about a diameter wide, so most
 /// hold fewer).
 pub const BLOCK: usize = 3;
+/// Words of a cell's block: its spheres, then its count.
+const WORDS: usize = BLOCK + 1;
+/// Length of the scratch window the stencils are gathered into.
+const SCRATCH: usize = WINDOW + WORDS;
 
 #[derive(Clone, Debug, Default)]
 pub struct CellBlocks {
     /// Per cell: the first `BLOCK` spheres, then the count.
-    blocks: Vec<[u32; BLOCK + 1]>,
+    blocks: Vec<[u32; WORDS]>,
     /// Spheres `BLOCK..count` of the cells holding more than `BLOCK`.
     overflow: HashMap<u32, Vec<u32>>,
     /// Each sphere's cell (`NONE` for one in no cell) and place in it.
@@ -30,17 +34,28 @@ impl CellBlocks {
         self.at.clear();
         self.at.resize(spheres, (NONE, NONE));
         self.blocks.clear();
-        self.blocks.resize(cells, [0; BLOCK + 1]);
+        self.blocks.resize(cells, [0; WORDS]);
         self.overflow.clear();
     }
 
     /// Bytes held on the heap.
     pub fn heap_bytes(&self) -> usize {
         let over: usize = self.overflow.values().map(|v| v.capacity() * 4 + 32).sum();
-        self.blocks.capacity() * size_of::<[u32; BLOCK + 1]>()
+        self.blocks.capacity() * size_of::<[u32; WORDS]>()
             + self.at.capacity() * size_of::<(u32, u32)>()
             + self.overflow.capacity() * (size_of::<(u32, Vec<u32>)>() + 1)
             + over
+    }
+
+    /// Cells, padding included.
+    pub fn cells(&self) -> usize {
+        self.blocks.len()
+    }
+
+    /// Spheres in cell `c`.
+    #[inline]
+    pub fn count(&self, c: usize) -> u32 {
+        self.blocks[c][BLOCK]
     }
 
     #[inline]
@@ -130,33 +145,35 @@ impl CellBlocks {
     pub fn gather(&self, base: usize, offsets: &[usize], out: &mut Vec<u32>) -> usize {
         // Room to copy a whole block for every cell, so each copy is
         // unconditional: one 16-byte move, the count landing past the end.
-        let room = (offsets.len() * BLOCK).max(WINDOW) + BLOCK + 1;
+        let room = (offsets.len() * BLOCK).max(WINDOW) + WORDS;
         if out.len() < room {
             out.resize(room, 0);
         }
         let mut n = 0;
         // The OR of the counts exceeds BLOCK exactly when one count does
-        // (BLOCK + 1 is a power of two): one OR per cell, one test at the end.
+        // (WORDS is a power of two): one OR per cell, one test at the end.
         let mut counts = 0;
-        if offsets.len() * BLOCK <= WINDOW {
-            // The stencils: writing at `n` masked to the window lets the
-            // compiler drop the bounds checks on `out` (the mask never
-            // bites, as `n` stays within it); they were half the work per
-            // cell.
-            let window: &mut [u32; WINDOW + BLOCK + 1] = (&mut out[..WINDOW + BLOCK + 1])
-                .try_into()
-                .expect("room checked above");
+        // The stencils: writing at `n` masked to the window lets the
+        // compiler drop the bounds checks on `out` (the mask never bites, as
+        // `n` stays within it); they were half the work per cell. `out` has
+        // the room (made above), so the window is always there.
+        let window = if offsets.len() * BLOCK <= WINDOW {
+            out.first_chunk_mut::<SCRATCH>()
+        } else {
+            None
+        };
+        if let Some(window) = window {
             for &o in offsets {
                 let b = &self.blocks[base + o];
                 let at = n & (WINDOW - 1);
-                window[at..at + BLOCK + 1].copy_from_slice(b);
+                window[at..at + WORDS].copy_from_slice(b);
                 counts |= b[BLOCK];
                 n += (b[BLOCK] as usize).min(BLOCK);
             }
         } else {
             for &o in offsets {
                 let b = &self.blocks[base + o];
-                out[n..n + BLOCK + 1].copy_from_slice(b);
+                out[n..n + WORDS].copy_from_slice(b);
                 counts |= b[BLOCK];
                 n += (b[BLOCK] as usize).min(BLOCK);
             }
@@ -185,13 +202,14 @@ impl CellBlocks {
         offsets: &[usize; K],
         out: &mut Vec<u32>,
     ) -> usize {
-        const { assert!(K * (BLOCK + 1) <= WINDOW) };
-        if out.len() < WINDOW + BLOCK + 1 {
-            out.resize(WINDOW + BLOCK + 1, 0);
+        const { assert!(K * WORDS <= WINDOW) };
+        if out.len() < SCRATCH {
+            out.resize(SCRATCH, 0);
         }
-        let window: &mut [u32; WINDOW + BLOCK + 1] = (&mut out[..WINDOW + BLOCK + 1])
-            .try_into()
-            .expect("room made above");
+        // Always there (room made above); the general gather otherwise.
+        let Some(window) = out.first_chunk_mut::<SCRATCH>() else {
+            return self.gather(base, offsets, out);
+        };
         // One bounds check per cell remains, never taken (a cell in the
         // grid has its stencil in the grid, padding included).
         let blocks = &self.blocks[base..];
@@ -202,7 +220,7 @@ impl CellBlocks {
             // Each count is at most BLOCK on this path, so `n` stays within
             // the window; the mask only lets the compiler see that.
             let at = n & (WINDOW - 1);
-            window[at..at + BLOCK + 1].copy_from_slice(b);
+            window[at..at + WORDS].copy_from_slice(b);
             counts |= b[BLOCK];
             n += b[BLOCK] as usize;
         }
@@ -215,7 +233,7 @@ impl CellBlocks {
 
 /// A power of two above the blocks of the 27-cell stencil.
 const WINDOW: usize = 128;
-const _: () = assert!((BLOCK + 1).is_power_of_two() && 27 * BLOCK <= WINDOW);
+const _: () = assert!(WORDS.is_power_of_two() && 27 * BLOCK <= WINDOW);
 
 #[cfg(test)]
 mod tests {

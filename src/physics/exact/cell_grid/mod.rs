@@ -1,5 +1,5 @@
 //! Broad phase for dilute and moderate scenes: a cell grid with
-//! cell-crossing events (Rapaport; DynamO). Cells are at least the largest
+//! cell-crossing events (Rapaport; `DynamO`). Cells are at least the largest
 //! bulk diameter, so spheres can only touch from neighbouring cells; a
 //! sphere's candidates are the spheres in the 27 cells around its own. A
 //! sphere changes cell only at a crossing event, so the pair bookkeeping is
@@ -41,6 +41,9 @@ pub struct CellGrid {
     /// and to the 9 of the layer a crossing brings next to it (one set per
     /// direction, indexed by the crossing's mask).
     stencil: [usize; 27],
+    /// Offsets from a cell to the 13 of its neighbours that come after it
+    /// in memory, so a search over cells meets each pair of cells once.
+    forward: [usize; 13],
     layers: [[usize; 9]; 8],
     /// Each small sphere's cell coordinates (unpadded), kept so that events
     /// need no integer division; `u16` as a side has at most 512 cells.
@@ -113,6 +116,10 @@ impl CellGrid {
         for (slot, c) in self.stencil.iter_mut().zip(near) {
             *slot = at(c[0], c[1], c[2]);
         }
+        let centre = at(1, 1, 1);
+        for (slot, c) in self.forward.iter_mut().zip(cube.clone().skip(14)) {
+            *slot = at(c[0], c[1], c[2]) - centre;
+        }
         for mask in 0..8u8 {
             let axis = (mask & 3) as usize;
             if axis == 3 {
@@ -132,6 +139,11 @@ impl CellGrid {
             + self.list.heap_bytes()
             + (self.bigs.capacity() + self.big_slot.capacity()) * 4
             + self.scan_centre.capacity() * size_of::<DVec3>()
+    }
+
+    /// The large spheres (in no cell).
+    pub fn bigs(&self) -> &[u32] {
+        &self.bigs
     }
 
     #[inline]
@@ -168,6 +180,7 @@ impl CellGrid {
             let up = v > 0.0;
             let face = ck + up as u32;
             let t = ((face as f64 * self.cell - b.pos[k]) / v).max(0.0);
+            #[allow(clippy::needless_bitwise_bool)] // branchless on purpose, as above
             let open = (ck != [0, last][up as usize]) & (v != 0.0);
             let t = [f64::INFINITY, t][open as usize];
             let better = t < best;
@@ -239,6 +252,37 @@ impl CellGrid {
         out.truncate(n);
         out.extend_from_slice(&self.bigs);
         out.len()
+    }
+
+    /// Cells of the grid, padding included (for cutting a search over them).
+    pub fn cells(&self) -> usize {
+        self.list.cells()
+    }
+
+    /// `f(i, j)` for every pair of small spheres in the same or neighbouring
+    /// cells among `cells` (all of them once when the ranges cover the grid;
+    /// the spheres that could touch, as for [`Self::candidates`]). `own` and
+    /// `near` are scratch.
+    pub fn for_each_near_pair(
+        &self,
+        cells: std::ops::Range<usize>,
+        own: &mut Vec<u32>,
+        near: &mut Vec<u32>,
+        mut f: impl FnMut(usize, usize),
+    ) {
+        for c in cells {
+            // Most cells are empty (up to 4 a sphere); padding always is.
+            if self.list.count(c) == 0 {
+                continue;
+            }
+            let k = self.list.gather_stencil(c, &[0], own);
+            let m = self.list.gather_stencil(c, &self.forward, near);
+            for (x, &i) in own[..k].iter().enumerate() {
+                for &j in own[x + 1..k].iter().chain(&near[..m]) {
+                    f(i as usize, j as usize);
+                }
+            }
+        }
     }
 
     /// After a crossing (`mask` as in [`Kind::Cross`]): the spheres in the

@@ -51,10 +51,10 @@ impl CellChains {
 
     pub fn remove(&mut self, i: usize) {
         let (p, n) = (self.prev[i], self.next[i]);
-        if p != NONE {
-            self.next[p as usize] = n;
-        } else {
+        if p == NONE {
             self.head[self.cell[i] as usize] = n;
+        } else {
+            self.next[p as usize] = n;
         }
         if n != NONE {
             self.prev[n as usize] = p;

@@ -330,7 +330,7 @@ impl NeighbourLists {
             for y in lo[1]..=hi[1] {
                 for x in lo[0]..=hi[0] {
                     self.cells.for_each_in(x + p * (y + p * z), |j| {
-                        test(j as usize, &self.centre, &mut self.lists)
+                        test(j as usize, &self.centre, &mut self.lists);
                     });
                 }
             }

@@ -1,0 +1,92 @@
+//! The overlap readout from the broad phase the event loop keeps anyway, so
+//! the engine builds no grid of its own for `exact`.
+//!
+//! Every overlapping pair is among the pairs checked here, by the invariants
+//! the event loop already relies on to miss no contact: in cell mode, cells
+//! are wider than a small sphere's diameter and crossings keep each small
+//! sphere in its cell, so overlapping small spheres sit in neighbouring
+//! cells, and a large sphere scans every cell it could reach; with
+//! neighbour lists, relists keep each sphere within the skin of its list
+//! centre, so two spheres that touch are listed.
+use super::body::Body;
+use super::queue::EventQueue;
+use super::{Broad, EventDriven};
+use crate::physics::exec::{Exec, for_each_block};
+use parking_lot::Mutex;
+
+/// Spheres (lists) or cells (grid) per block of the search, spread over
+/// the executor's lanes.
+const BLOCK: usize = 1 << 12;
+const CELL_BLOCK: usize = 1 << 14;
+
+impl<Q: EventQueue> EventDriven<Q> {
+    /// The deepest overlap between the bodies divided by the smaller radius
+    /// (0 if none), as `World::max_overlap_rel` gives it for the world the
+    /// bodies were last written to (the max is order-free, so the same bits).
+    pub(super) fn deepest_overlap(&self, exec: &dyn Exec) -> f64 {
+        let (bodies, broad) = (&self.bodies[..], &self.broad);
+        let worst = Mutex::new(0.0f64);
+        let keep = |deepest: f64| {
+            let mut w = worst.lock();
+            *w = w.max(deepest);
+        };
+        match broad {
+            Broad::Lists(nl) => {
+                let n = bodies.len();
+                for_each_block(exec, n.div_ceil(BLOCK), &|b| {
+                    let spheres = b * BLOCK..((b + 1) * BLOCK).min(n);
+                    keep(spheres.fold(0.0, |w: f64, i| {
+                        nl.of(i)
+                            .iter()
+                            .filter(|l| l.j as usize > i)
+                            .fold(w, |w, l| deeper(w, bodies, i, l.j as usize))
+                    }));
+                });
+            }
+            Broad::Cells(cells) => {
+                let n = cells.cells();
+                for_each_block(exec, n.div_ceil(CELL_BLOCK), &|b| {
+                    let (mut own, mut near, mut w) = (Vec::new(), Vec::new(), 0.0);
+                    let range = b * CELL_BLOCK..((b + 1) * CELL_BLOCK).min(n);
+                    cells.for_each_near_pair(range, &mut own, &mut near, |i, j| {
+                        w = deeper(w, bodies, i, j);
+                    });
+                    keep(w);
+                });
+                // The few large ones: each small one they could touch, from
+                // their scan, and each other.
+                let mut out = Vec::new();
+                for &i in cells.bigs() {
+                    let i = i as usize;
+                    let k = cells.candidates(i, &bodies[i], &mut out);
+                    keep(
+                        out[..k]
+                            .iter()
+                            .map(|&j| j as usize)
+                            .filter(|&j| !cells.is_big(j) || j > i)
+                            .fold(0.0, |w, j| deeper(w, bodies, i, j)),
+                    );
+                }
+            }
+        }
+        worst.into_inner()
+    }
+}
+
+/// `worst`, or the overlap of bodies `i` and `j` relative to the smaller
+/// radius if deeper: the depth computed as `World::max_overlap_rel` does.
+#[inline]
+fn deeper(worst: f64, bodies: &[Body], i: usize, j: usize) -> f64 {
+    let (a, b) = (&bodies[i], &bodies[j]);
+    let s = a.radius + b.radius;
+    // sqrt(fl(s * s)) == s, so a pair this skips has a depth of at most 0.
+    if a.pos.distance_squared(b.pos) >= s * s {
+        return worst;
+    }
+    let depth = s - a.pos.distance(b.pos);
+    if depth > 0.0 {
+        worst.max(depth / a.radius.min(b.radius))
+    } else {
+        worst
+    }
+}
