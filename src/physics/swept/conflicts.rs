@@ -137,7 +137,6 @@ impl Conflicts {
         }
         // Every slot's ball, indexed by slot.
         self.balls.clear();
-        self.balls.reserve_exact(m);
         for s in 0..m {
             let (centre, reach) = fin.ball(s, part.ids[s], spheres, dt);
             self.balls.push(Sphere {
