@@ -10,17 +10,17 @@ use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::collections::BTreeSet;
 
-/// 70 000 balls (past the keyed threshold): most small, a few a hundred
-/// times wider (they go up to coarser levels and the last few).
+/// 270 000 balls (past the keyed threshold, 2^18): most small, a few a
+/// hundred times wider (they go up to coarser levels and the last few).
 fn balls(seed: u64) -> Vec<Sphere> {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-    (0..70_000)
+    (0..270_000)
         .map(|k| {
             let p = DVec3::new(rng.random(), rng.random(), rng.random());
-            let r = if k % 997 == 0 {
-                rng.random_range(0.02..0.2)
+            let r = if k % 4999 == 0 {
+                rng.random_range(0.02..0.1)
             } else {
-                rng.random_range(0.001..0.006)
+                rng.random_range(0.0005..0.004)
             };
             Sphere::new(p, DVec3::ZERO, r)
         })
