@@ -61,7 +61,7 @@ impl Detection {
                         v.push((b * SPHERE_BLOCK + i) as u32);
                     }
                 }
-            })
+            });
         };
         if exec.functional() {
             let pair_job = Mutex::new((&mut self.grid, &mut self.pairs, true));

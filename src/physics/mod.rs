@@ -5,7 +5,6 @@
 // fixed next (some in hot loops want a measurement), and these allows go then.
 pub mod broad;
 pub mod contact;
-#[allow(clippy::semicolon_if_nothing_returned)]
 mod detect;
 pub mod discrete;
 pub mod edit;
@@ -16,7 +15,6 @@ pub mod model;
 pub mod reference;
 pub mod relax;
 pub mod sphere;
-#[allow(clippy::return_self_not_must_use, clippy::too_many_lines)]
 pub mod swept;
 pub mod world;
 

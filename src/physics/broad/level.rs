@@ -99,14 +99,44 @@ fn running_sums(counts: &mut [u32], start: u32) -> u32 {
 /// Room for `n` entries and the `NOWHERE` pad; the old contents stay (the
 /// scatter writes every slot), so no serial pass clears them. Takes the
 /// entries, not the level, so it can run while the cell table is lent out.
+/// The count is known, so the room is sized to it (a sixty-fourth over,
+/// so a level that gains a few spheres is not moved every step): growing
+/// by `resize` then `push` doubled it.
 fn room(entries: &mut Vec<Entry>, n: usize) {
     entries.truncate(n);
+    if entries.capacity() < n + 1 {
+        entries.reserve_exact(n + 1 + n / 64 - entries.len());
+    }
     entries.resize(n, Entry::default());
     entries.push(Entry {
         ball: NOWHERE,
         ..Entry::default()
     });
 }
+/// Where the first level's records come from while it sorts them.
+pub(super) trait Source: Sync {
+    /// Each sphere's (cell key, reach), in id order.
+    fn keys(&self) -> impl DoubleEndedIterator<Item = (u32, f64)> + ExactSizeIterator;
+    /// Sphere `i`'s record.
+    fn entry(&self, i: usize) -> Entry;
+    /// The records themselves, when they lie in memory in id order.
+    fn records(&self) -> Option<&[Entry]>;
+}
+
+impl Source for [Entry] {
+    #[inline(always)]
+    fn keys(&self) -> impl DoubleEndedIterator<Item = (u32, f64)> + ExactSizeIterator {
+        self.iter().map(|e| (e.key, e.ball.reach))
+    }
+    #[inline(always)]
+    fn entry(&self, i: usize) -> Entry {
+        self[i]
+    }
+    fn records(&self) -> Option<&[Entry]> {
+        Some(self)
+    }
+}
+
 impl Level {
     /// Sizes the level for `n` spheres wanting cells of `want`. The cell
     /// table is zeroed here unless `lanes_zero` (the lanes of `fill_lanes`
@@ -188,10 +218,12 @@ impl Level {
     /// table and of the entries, so the layout is the same for any number
     /// of lanes.
     /// `counted`: the cell table already holds the counts of one lane
-    /// (made while staging), with (how many, widest reach).
-    pub(super) fn fill_lanes(
+    /// (made while staging), with (how many, widest reach). A source
+    /// without `records` is placed through the index arrays, and its keys'
+    /// reaches are not read (the caller keeps the widest).
+    pub(super) fn fill_lanes<S: Source + ?Sized>(
         &mut self,
-        staged: &[Entry],
+        staged: &S,
         exec: &dyn Exec,
         counted: Option<(u32, f64)>,
     ) {
@@ -222,13 +254,13 @@ impl Level {
             table.fill(0);
             let mut reach_max: f64 = 0.0;
             let mut count = 0;
-            for s in staged {
-                if s.key >= lo && s.key < hi {
-                    table[(s.key - lo) as usize] += 1;
+            for (key, reach) in staged.keys() {
+                if key >= lo && key < hi {
+                    table[(key - lo) as usize] += 1;
                     // Not `f64::max`: its NaN handling makes a slow chain
                     // through every sphere, and reaches are never NaN here.
-                    if s.ball.reach > reach_max {
-                        reach_max = s.ball.reach;
+                    if reach > reach_max {
+                        reach_max = reach;
                     }
                     count += 1;
                 }
@@ -250,7 +282,7 @@ impl Level {
         // array that stays in cache) and copies the records over in order,
         // reading them where they lie (reads of misses overlap; writes of
         // them held the sort up).
-        let indirect = staged.len() / lanes >= INDIRECT_MIN;
+        let records = staged.records().filter(|r| r.len() / lanes < INDIRECT_MIN);
         self.orders.resize_with(lanes, Default::default);
         let orders = &self.orders;
         let mut regions: Vec<Mutex<&mut [Entry]>> = Vec::with_capacity(lanes);
@@ -268,8 +300,8 @@ impl Level {
             let mut table = tables[l].lock();
             running_sums(&mut table, offsets[l]);
             let mut region = regions[l].lock();
-            if !indirect {
-                for s in staged.iter().rev() {
+            if let Some(records) = records {
+                for s in records.iter().rev() {
                     if s.key >= lo && s.key < hi {
                         let slot = &mut table[(s.key - lo) as usize];
                         *slot -= 1;
@@ -279,16 +311,22 @@ impl Level {
                 return;
             }
             let mut order = orders[l].lock();
+            order.truncate(region.len());
+            if order.capacity() < region.len() {
+                // Exact, a sixty-fourth over: `resize` would double it.
+                let more = region.len() + region.len() / 64 - order.len();
+                order.reserve_exact(more);
+            }
             order.resize(region.len(), 0);
-            for (i, s) in staged.iter().enumerate().rev() {
-                if s.key >= lo && s.key < hi {
-                    let slot = &mut table[(s.key - lo) as usize];
+            for (i, (key, _)) in staged.keys().enumerate().rev() {
+                if key >= lo && key < hi {
+                    let slot = &mut table[(key - lo) as usize];
                     *slot -= 1;
                     order[(*slot - offsets[l]) as usize] = i as u32;
                 }
             }
             for (e, &i) in region.iter_mut().zip(order.iter()) {
-                *e = staged[i as usize];
+                *e = staged.entry(i as usize);
             }
         });
         drop(tables);

@@ -11,7 +11,7 @@ mod level;
 use super::exec::{Exec, for_each_block, for_each_chunk};
 use super::sphere::Sphere;
 use glam::DVec3;
-use level::{Ball, Entry, Level, within};
+use level::{Ball, Entry, Level, Source, within};
 use parking_lot::Mutex;
 use std::cell::Cell;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -29,6 +29,11 @@ const BUILD_BLOCK: usize = 4096;
 const LIMIT_FLUSH: usize = 256;
 /// The first level's cell comes from every this-many-th reach.
 const SAMPLE_STRIDE: usize = 32;
+/// From this many spheres on, the first level is staged as cell keys alone
+/// and each record is made again where it is placed: 4 bytes a sphere held
+/// instead of a 40-byte record, for a second `ball` per sphere (at 100 000
+/// dilute spheres that cost about a tenth more time; at a million, none).
+const KEYED_MIN: usize = 1 << 18;
 
 /// A pair that may touch: sphere indices, `i < j` not implied.
 pub type Pair = (u32, u32);
@@ -38,6 +43,10 @@ pub struct Grid {
     /// The last few, tested against everything.
     top: Vec<(Ball, u32)>,
     staged: Vec<Entry>,
+    /// From [`KEYED_MIN`] spheres on, in place of `staged`: the cell keys.
+    keys: Vec<u32>,
+    /// Per block of spheres, the widest ball among the keyed ones.
+    widest: Vec<Mutex<f64>>,
     /// The box's side, as of the last build.
     size: f64,
     /// Spheres not yet placed in a level: (ball, id).
@@ -47,6 +56,32 @@ pub struct Grid {
     /// in parallel, joined in block order).
     wide: Vec<Mutex<Vec<(Ball, u32)>>>,
     slots: Vec<Mutex<Vec<Pair>>>,
+}
+
+/// The first level's records as cell keys and the spheres they come from.
+struct Keyed<'a, B> {
+    keys: &'a [u32],
+    spheres: &'a [Sphere],
+    ball: &'a B,
+}
+
+impl<B: Fn(&Sphere) -> (DVec3, f64) + Sync> Source for Keyed<'_, B> {
+    #[inline(always)]
+    fn keys(&self) -> impl DoubleEndedIterator<Item = (u32, f64)> + ExactSizeIterator {
+        self.keys.iter().map(|&k| (k, 0.0))
+    }
+    #[inline(always)]
+    fn entry(&self, i: usize) -> Entry {
+        let (pos, reach) = (self.ball)(&self.spheres[i]);
+        Entry {
+            ball: Ball { pos, reach },
+            id: i as u32,
+            key: self.keys[i],
+        }
+    }
+    fn records(&self) -> Option<&[Entry]> {
+        None
+    }
 }
 /// Twice the 98th percentile of `reach` (estimated on every `stride`-th
 /// value: a function of the state only, so the grid, and the order pairs
@@ -121,11 +156,16 @@ impl Grid {
             let want = cell_of_sample(&mut self.scratch, max);
             let level = &mut self.levels[0];
             level.shape(size, want, n, true);
-            self.staged.resize(n, Entry::default());
             self.rest.clear();
-            // Under this many spheres, waking other threads costs more than
-            // the sort; the layout is the same for any number of lanes.
-            if n < LANES_MIN_SPHERES || exec.lanes() <= 1 {
+            if n >= KEYED_MIN {
+                self.staged = Vec::new();
+                self.build_keyed(spheres, &ball, exec);
+            } else if n < LANES_MIN_SPHERES || exec.lanes() <= 1 {
+                // Under this many spheres, waking other threads costs more
+                // than the sort; the layout is the same for any number of
+                // lanes.
+                self.keys = Vec::new();
+                self.staged.resize(n, Entry::default());
                 // One lane: the cells are counted while staging, so the
                 // table's increments overlap the arithmetic of the balls
                 // and the staged records are read once less.
@@ -142,8 +182,10 @@ impl Grid {
                         }
                     }
                 }
-                level.fill_lanes(&self.staged, exec, Some((count, reach_max)));
+                level.fill_lanes(&self.staged[..], exec, Some((count, reach_max)));
             } else {
+                self.keys = Vec::new();
+                self.staged.resize(n, Entry::default());
                 let blocks = n.div_ceil(BUILD_BLOCK);
                 self.wide.resize_with(blocks, Default::default);
                 let level = &*level;
@@ -157,7 +199,7 @@ impl Grid {
                         *slot = level.stage(ball(s), id, &mut wide);
                     }
                 });
-                self.levels[0].fill_lanes(&self.staged, exec, None);
+                self.levels[0].fill_lanes(&self.staged[..], exec, None);
                 for w in &self.wide[..blocks] {
                     self.rest.extend_from_slice(&w.lock());
                 }
@@ -206,6 +248,54 @@ impl Grid {
             }));
         }
         self.levels.truncate(depth);
+    }
+
+    /// The first level of [`Grid::build`] from [`KEYED_MIN`] spheres on:
+    /// each sphere's cell key is staged (and the widest ball kept) in
+    /// parallel blocks, then the level sorts the spheres by key and makes
+    /// each record again where it goes. The same level as from records.
+    fn build_keyed(
+        &mut self,
+        spheres: &[Sphere],
+        ball: &(impl Fn(&Sphere) -> (DVec3, f64) + Sync),
+        exec: &dyn Exec,
+    ) {
+        let n = spheres.len();
+        let blocks = n.div_ceil(BUILD_BLOCK);
+        self.keys.resize(n, 0);
+        self.wide.resize_with(blocks, Default::default);
+        self.widest.resize_with(blocks, Default::default);
+        let level = &self.levels[0];
+        let (wide, widest) = (&self.wide, &self.widest);
+        for_each_chunk(exec, &mut self.keys, BUILD_BLOCK, &|b, chunk| {
+            let mut wide = wide[b].lock();
+            wide.clear();
+            let mut reach_max = 0.0f64;
+            let first = (b * BUILD_BLOCK) as u32;
+            let mine = chunk.iter_mut().zip(&spheres[b * BUILD_BLOCK..]);
+            for ((slot, s), id) in mine.zip(first..) {
+                let e = level.stage(ball(s), id, &mut wide);
+                // Not `f64::max`: see `fill_lanes`.
+                if e.key != u32::MAX && e.ball.reach > reach_max {
+                    reach_max = e.ball.reach;
+                }
+                *slot = e.key;
+            }
+            *widest[b].lock() = reach_max;
+        });
+        let keyed = Keyed {
+            keys: &self.keys,
+            spheres,
+            ball,
+        };
+        let level = &mut self.levels[0];
+        level.fill_lanes(&keyed, exec, None);
+        for w in &self.widest[..blocks] {
+            level.reach_max = level.reach_max.max(*w.lock());
+        }
+        for w in &self.wide[..blocks] {
+            self.rest.extend_from_slice(&w.lock());
+        }
     }
 
     fn units(&self) -> Vec<Unit> {

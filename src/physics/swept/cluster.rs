@@ -404,7 +404,33 @@ impl Run {
     /// before the step ends. Anyone else it might meet is a conflict.
     fn rescan(&mut self, sh: &Shared, la: usize, t: f64, absorb: bool) {
         let sa = self.sp[la];
-        let ia = self.ids[la];
+        self.grow_reach(sh, la, &sa, t);
+        let ca = self.count[la];
+        push_wall(
+            &mut self.heap,
+            &sa,
+            self.ids[la],
+            Local::at(la),
+            t,
+            ca,
+            sh.size,
+            sh.dt,
+        );
+        let mut found = std::mem::take(&mut self.found);
+        found.clear();
+        let seen = self.search(sh, la, &sa, t, absorb, &mut found);
+        // A sphere found within reach is sorted and its path solved too.
+        self.work += seen + FOUND_WORK * found.len() as u64;
+        found.sort_unstable();
+        found.dedup();
+        self.schedule(sh, la, &sa, t, &found);
+        self.found = found;
+    }
+
+    /// Widens member `la`'s ball for the step to hold the rest of its new
+    /// path (`sa` from `t` on); one grown past its cap joins `grown`.
+    #[inline(always)]
+    fn grow_reach(&mut self, sh: &Shared, la: usize, sa: &Sphere, t: f64) {
         let need =
             ((sa.pos - self.centre[la]).length() + sa.vel.length() * (sh.dt - t) + sa.radius)
                 * REACH_SLACK;
@@ -416,19 +442,21 @@ impl Run {
             }
             self.reach[la] = need;
         }
-        let ca = self.count[la];
-        push_wall(
-            &mut self.heap,
-            &sa,
-            ia,
-            Local::at(la),
-            t,
-            ca,
-            sh.size,
-            sh.dt,
-        );
-        let mut found = std::mem::take(&mut self.found);
-        found.clear();
+    }
+
+    /// The spheres whose balls may meet the rest of member `la`'s path
+    /// (`sa` from `t` on), into `found` (unsorted, maybe twice, maybe
+    /// itself); returns how many it looked at.
+    #[inline(always)]
+    fn search(
+        &self,
+        sh: &Shared,
+        la: usize,
+        sa: &Sphere,
+        t: f64,
+        absorb: bool,
+        found: &mut Vec<u32>,
+    ) -> u64 {
         // Only what is left of the path can meet anyone: the ball around
         // the rest of it is searched, not the whole step's.
         let rem = 0.5 * (sh.dt - t);
@@ -436,7 +464,6 @@ impl Run {
             sa.pos + sa.vel * rem,
             (sa.radius + sa.vel.length() * rem) * REACH_SLACK,
         );
-        let this = &*self;
         let mut seen = 0u64;
         if !absorb && self.ids.len() <= SMALL_RUN {
             // Members are few: they are checked one by one with their grown
@@ -445,7 +472,7 @@ impl Run {
                 seen += 1;
                 // The distance first: it reads what the grid handed over,
                 // the member table is a read elsewhere in memory.
-                if q.distance_squared(pj0) <= (rq + rj) * (rq + rj) && this.member(j).is_none() {
+                if q.distance_squared(pj0) <= (rq + rj) * (rq + rj) && self.member(j).is_none() {
                     found.push(j);
                 }
             };
@@ -453,8 +480,8 @@ impl Run {
             // sphere's binned ball (well inside: far above rounding), every
             // non-member it can meet is one of the pairs the grid already
             // found for it, and the same test picks the same ones.
-            let inside = (q - this.centre[la]).length() + rq <= this.reach0[la] * (1.0 - 1e-9);
-            match sh.partners_of(this.slots[la]).filter(|_| inside) {
+            let inside = (q - self.centre[la]).length() + rq <= self.reach0[la] * (1.0 - 1e-9);
+            match sh.partners_of(self.slots[la]).filter(|_| inside) {
                 Some(partners) => {
                     for &j in partners {
                         let (pj0, rj) = path_ball(&sh.spheres[j as usize], sh.dt);
@@ -463,11 +490,11 @@ impl Run {
                 }
                 None => sh.grid.near(q, rq, 1.0, &mut non_member),
             }
-            seen += this.ids.len() as u64;
-            for l in 0..this.ids.len() {
-                let r = rq + this.reach[l];
-                if l != la && q.distance_squared(this.centre[l]) <= r * r {
-                    found.push(this.ids[l]);
+            seen += self.ids.len() as u64;
+            for l in 0..self.ids.len() {
+                let r = rq + self.reach[l];
+                if l != la && q.distance_squared(self.centre[l]) <= r * r {
+                    found.push(self.ids[l]);
                 }
             }
         } else {
@@ -477,22 +504,27 @@ impl Run {
             // checked by hand.
             let mut consider = |j: u32, pj0: DVec3, rj: f64| {
                 seen += 1;
-                let rj = this.member(j).map_or(rj, |l| this.reach[l]);
+                let rj = self.member(j).map_or(rj, |l| self.reach[l]);
                 if q.distance_squared(pj0) <= (rq + rj) * (rq + rj) {
                     found.push(j);
                 }
             };
             sh.grid.near(q, rq, GROWTH_CAP, &mut consider);
-            for &g in &this.grown {
+            for &g in &self.grown {
                 let lg = g as usize;
-                consider(this.ids[lg], this.centre[lg], this.reach[lg]);
+                consider(self.ids[lg], self.centre[lg], self.reach[lg]);
             }
         }
-        // A sphere found within reach is sorted and its path solved too.
-        self.work += seen + FOUND_WORK * found.len() as u64;
-        found.sort_unstable();
-        found.dedup();
-        for &j in &found {
+        seen
+    }
+
+    /// Solves member `la`'s new path (`sa` at `t`) against each of `found`
+    /// and queues the contacts within the step; a bystander it meets joins
+    /// the run, a member of another cluster is noted in `cross`.
+    #[inline(always)]
+    fn schedule(&mut self, sh: &Shared, la: usize, sa: &Sphere, t: f64, found: &[u32]) {
+        let (ia, ca) = (self.ids[la], self.count[la]);
+        for &j in found {
             if j == ia {
                 continue;
             }
@@ -532,7 +564,6 @@ impl Run {
             self.heap
                 .push(pair_event(t + dtc, ia, j, Local::at(la), lb, ca, cb));
         }
-        self.found = found;
     }
 }
 

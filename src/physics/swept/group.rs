@@ -11,19 +11,19 @@ pub(super) fn group<T: Copy + Default>(
 ) {
     starts.clear();
     starts.resize(keys + 1, 0);
-    for (k, _) in items.clone() {
-        starts[k as usize + 1] += 1;
-    }
+    // `for_each`, not `for`: chained pair lists are then walked list by
+    // list, not item by item through the chain.
+    items.clone().for_each(|(k, _)| starts[k as usize + 1] += 1);
     for k in 0..keys {
         starts[k + 1] += starts[k];
     }
     out.clear();
     out.resize(starts[keys] as usize, T::default());
-    for (k, v) in items {
+    items.for_each(|(k, v)| {
         let at = &mut starts[k as usize];
         out[*at as usize] = v;
         *at += 1;
-    }
+    });
     // Placing moved each start to the next key's; shift back.
     for k in (1..=keys).rev() {
         starts[k] = starts[k - 1];

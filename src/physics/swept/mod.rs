@@ -206,6 +206,7 @@ impl Swept {
 
     /// Cut every step into `k` parts instead of the number the scene
     /// calls for (see `parts.rs`); `None` goes back to that.
+    #[must_use]
     pub fn fixed_parts(mut self, k: Option<u32>) -> Self {
         self.fixed_parts = k.map(|k| k.clamp(1, parts::MAX_PARTS));
         self
@@ -219,6 +220,7 @@ impl Swept {
 
     /// Run every step's events as one serial loop, not in clusters (the
     /// reference the clusters must match).
+    #[must_use]
     pub fn serial_events(mut self, on: bool) -> Self {
         self.rounds.serial_only = on;
         self
