@@ -1,8 +1,5 @@
 //! The physics: spheres in a cube, the collision models, the broad phase.
 //! It knows nothing of threads (it is handed an [`exec::Exec`]) or terminals.
-// Issue 19's [lints] arrived while these modules were being restructured in
-// parallel: what pedantic and the unwrap/expect lints find in them is to be
-// fixed next (some in hot loops want a measurement), and these allows go then.
 pub mod broad;
 pub mod contact;
 mod detect;
