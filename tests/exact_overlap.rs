@@ -7,26 +7,13 @@
 use ballpit::physics::exact::{Exact, LISTS_ABOVE_PACKING};
 use ballpit::physics::sphere::volume;
 use ballpit::physics::{Exec, Model, Serial, Sphere, World};
+#[path = "common/bits.rs"]
+mod bits;
 use ballpit::scene::lattice::lattice_world;
+use bits::Lanes;
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
-
-/// Lanes run one after another, last first.
-struct Lanes(usize);
-
-impl Exec for Lanes {
-    fn lanes(&self) -> usize {
-        self.0
-    }
-    fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
-        (0..self.0).rev().for_each(f);
-    }
-    fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {
-        b();
-        a();
-    }
-}
 
 fn packing(w: &World) -> f64 {
     w.spheres.iter().map(|s| volume(s.radius)).sum::<f64>() / w.size.powi(3)
