@@ -5,7 +5,8 @@
 //! - lazy update: each sphere carries its own time stamp ([`body`]) and is
 //!   moved only when an event touches it or when `advance` returns;
 //! - one pending event per sphere (the earliest of contact, wall, or its
-//!   broad-phase event), in an [`EventQueue`] (a tournament tree);
+//!   broad-phase event), in an [`EventQueue`] (a tournament tree, or the
+//!   bucket queue [`calendar`]);
 //! - a broad phase chosen by packing fraction ([`LISTS_ABOVE_PACKING`]):
 //!   a cell grid with cell-crossing events for dilute and moderate scenes
 //!   ([`cell_grid`]), neighbour lists with a skin for dense ones
@@ -110,7 +111,9 @@ pub struct Contact {
 
 pub type Observer = Box<dyn FnMut(&Contact) + Send>;
 
-/// The model, with today's event queue.
+/// The model, with today's event queue. The tournament stays the default:
+/// the calendar measured slower at 10k spheres and at packing 0.1 and 0.4,
+/// faster only at 1M dilute (docs/benchmarks.md, "exact's event queue").
 pub type Exact = EventDriven<Tournament>;
 
 /// The model over an event queue `Q` ([`Tournament`] or [`Calendar`]; a
