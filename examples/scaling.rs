@@ -8,16 +8,21 @@
 //!
 //! `cargo run --release --example scaling -- [rounds] [sorted]`
 //!
-//! `cargo run --release --example scaling -- exact [rounds] [max N] [renumber]`:
-//! the exact model at 10k, 100k and 1M spheres (up to `max N`), packing
-//! 0.005, 0.1 and 0.4 (the radius set by N, the box 1, seed 5, as
-//! `ballpit bench --count N --radius R --seed 5`). Per size: the time to
-//! load the spheres (the first advance, a step of 1e-9 s), the model's heap
-//! bytes per sphere, then blocks of steps of 2 ms (100 at 10k, 10 at 100k, 2
-//! at 1M) timed in alternation between the sizes: ns per sphere-step and
-//! events (collisions, crossings, walls, relists, stale) per second, and the
-//! 10k rate over that rate. With `renumber` the model sorts its spheres
-//! again as they drift (default: only at load).
+//! `cargo run --release --example scaling -- table [rounds] [max N] [model ...]`:
+//! each model (default all three) at 10k, 100k and 1M spheres (up to
+//! `max N`), packing 0.005 and 0.1, and 0.4 for `exact` (the radius set by
+//! N, the box 1, seed 5, as `ballpit bench --count N --radius R --seed 5`).
+//! Per size: the time to load the spheres (the first advance, a step of
+//! 1e-9 s), `exact`'s heap bytes per sphere, the peak resident bytes per
+//! sphere of a process that builds the scene and runs two steps (a child
+//! process per size, less what it held before the scene), then blocks of steps (`exact`: 2 ms, 100
+//! at 10k, 10 at 100k, 1 at 1M; the others: 1/60 s, 20, 2 and 1) timed in
+//! alternation between the sizes: ns per sphere-step and events per second
+//! (`exact`: collisions, crossings, walls, relists, stale; the others:
+//! sphere and wall contacts), each against 10k's.
+//! `exact [rounds] [max N] [renumber]` is the table of `exact` alone; with
+//! `renumber` the model sorts its spheres again as they drift (default:
+//! only at load).
 //! `exact-one N packing steps [dt] [renumber] [calendar]` runs one size only
 //! (for callgrind); with `renumber` the model sorts its spheres again as
 //! they drift, with `calendar` it runs over the calendar queue.
@@ -286,90 +291,203 @@ fn status_kib(field: &str) -> u64 {
         .unwrap_or(0)
 }
 
-/// One size of the exact runs and what its timed blocks add up to.
+/// The model a size runs: `exact` concretely, for its event counts and heap.
+enum Held {
+    Exact(Box<Exact>),
+    Other(Box<dyn Model>),
+}
+
+impl Held {
+    fn new(kind: ModelKind, renumber: bool) -> Held {
+        match kind {
+            ModelKind::Exact => Held::Exact(Box::new(Exact::default().with_renumbering(renumber))),
+            other => Held::Other(other.build()),
+        }
+    }
+
+    fn model(&mut self) -> &mut dyn Model {
+        match self {
+            Held::Exact(m) => &mut **m,
+            Held::Other(m) => &mut **m,
+        }
+    }
+
+    /// Events so far: `exact`'s every kind (contacts, crossings, walls,
+    /// relists, stale), the others' contacts (sphere and wall).
+    fn events(&self, world: &World) -> u64 {
+        match self {
+            Held::Exact(m) => events(&m.stats),
+            Held::Other(_) => world.counters.sphere_collisions + world.counters.wall_collisions,
+        }
+    }
+}
+
+/// One size of a model's runs and what its timed blocks add up to.
 struct Run {
     n: usize,
     world: World,
-    model: Exact,
+    model: Held,
     /// Steps a timed block.
     block: u64,
     load: f64,
-    bytes: f64,
+    /// `exact`'s own heap a sphere (`None` for the others).
+    heap: Option<f64>,
+    /// Peak resident memory a sphere of a process that builds the scene
+    /// and runs two steps, less the process before it built anything.
+    peak: f64,
     spent: Duration,
     events: u64,
     steps: u64,
 }
 
-fn exact_scaling(args: &[String]) {
+/// `table [rounds] [max N] [model ...] [renumber]` (and `exact ...`, the
+/// same for `exact` alone): per model and packing, the sizes 10k, 100k
+/// and 1M timed in alternation.
+fn table(args: &[String], default_models: &[ModelKind]) {
     let rounds: usize = args.first().map_or(5, |r| r.parse().expect("rounds"));
     let max: usize = args.get(1).map_or(1_000_000, |m| m.parse().expect("max N"));
     let renumber = args.iter().any(|a| a == "renumber");
+    let mut models: Vec<ModelKind> = args.iter().filter_map(|a| a.parse().ok()).collect();
+    if models.is_empty() {
+        models = default_models.to_vec();
+    }
     let sizes: Vec<usize> = [10_000, 100_000, 1_000_000]
         .into_iter()
         .filter(|&n| n <= max)
         .collect();
-    for packing in [0.005, 0.1, 0.4] {
-        let mut runs = Vec::new();
-        for &n in &sizes {
-            let mut world = exact_scene(n, packing);
-            let mut model = Exact::default().with_renumbering(renumber);
+    for kind in models {
+        // `exact` takes 2 ms steps (thousands of events each at 10k); the
+        // per-step models the screen's 1/60 s.
+        let (dt, work, packings): (f64, u64, &[f64]) = match kind {
+            ModelKind::Exact => (DT_EXACT, 1_000_000, &[0.005, 0.1, 0.4]),
+            _ => (DT, 200_000, &[0.005, 0.1]),
+        };
+        for &packing in packings {
+            let runs = build_runs(kind, &sizes, packing, work, renumber);
+            time_runs(runs, rounds, dt, kind, packing);
+        }
+    }
+}
+
+fn build_runs(
+    kind: ModelKind,
+    sizes: &[usize],
+    packing: f64,
+    work: u64,
+    renumber: bool,
+) -> Vec<Run> {
+    let mut runs = Vec::new();
+    for &n in sizes {
+        let peak = peak_bytes(kind, n, packing);
+        let mut world = exact_scene(n, packing);
+        let mut model = Held::new(kind, renumber);
+        let start = Instant::now();
+        model.model().advance(&mut world, 1e-9, 1, &Serial);
+        let load = start.elapsed().as_secs_f64();
+        let heap = match &model {
+            Held::Exact(m) => Some(m.heap_bytes() as f64 / n as f64),
+            Held::Other(_) => None,
+        };
+        runs.push(Run {
+            n,
+            world,
+            model,
+            // The same dt at every size, so the per-step work outside
+            // the event loop (checking and writing back the world,
+            // linear in N) stays a small share; fewer steps as N grows.
+            block: (work / n as u64).max(1),
+            load,
+            heap,
+            peak,
+            spent: Duration::ZERO,
+            events: 0,
+            steps: 0,
+        });
+    }
+    runs
+}
+
+/// The peak resident bytes a sphere of `n` spheres under `kind`, in a
+/// child process (`peak MODEL N PACKING`) so that no other size's memory
+/// counts: its peak less what it held before building the scene.
+fn peak_bytes(kind: ModelKind, n: usize, packing: f64) -> f64 {
+    let out = std::process::Command::new(std::env::current_exe().expect("this example"))
+        .args(["peak", kind.name(), &n.to_string(), &packing.to_string()])
+        .output()
+        .expect("the peak run");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout)
+        .trim()
+        .parse()
+        .expect("bytes")
+}
+
+/// The child of [`peak_bytes`]: the scene, the model's load and two steps.
+fn peak(args: &[String]) {
+    let kind: ModelKind = args[0].parse().expect("model");
+    let n: usize = args[1].parse().expect("N");
+    let packing: f64 = args[2].parse().expect("packing");
+    let before = status_kib("VmHWM:");
+    let mut world = exact_scene(n, packing);
+    let mut model = Held::new(kind, false);
+    let dt = if kind == ModelKind::Exact {
+        DT_EXACT
+    } else {
+        DT
+    };
+    model.model().advance(&mut world, 1e-9, 1, &Serial);
+    model.model().advance(&mut world, dt, 2, &Serial);
+    let grown = status_kib("VmHWM:").saturating_sub(before);
+    println!("{}", grown as f64 * 1024.0 / n as f64);
+}
+
+fn time_runs(mut runs: Vec<Run>, rounds: usize, dt: f64, kind: ModelKind, packing: f64) {
+    for _ in 0..rounds {
+        for r in &mut runs {
+            // Untimed: the caches after the other sizes.
+            r.model.model().advance(&mut r.world, dt, 1, &Serial);
+            let e0 = r.model.events(&r.world);
             let start = Instant::now();
-            model.advance(&mut world, 1e-9, 1, &Serial);
-            let load = start.elapsed().as_secs_f64();
-            let bytes = model.heap_bytes() as f64 / n as f64;
-            runs.push(Run {
-                n,
-                world,
-                model,
-                // The same dt at every size, so the per-step work outside
-                // the event loop (checking and writing back the world,
-                // linear in N) stays a small share; fewer steps as N grows.
-                block: (1_000_000 / n as u64).max(2),
-                load,
-                bytes,
-                spent: Duration::ZERO,
-                events: 0,
-                steps: 0,
-            });
+            r.model.model().advance(&mut r.world, dt, r.block, &Serial);
+            r.spent += start.elapsed();
+            r.events += r.model.events(&r.world) - e0;
+            r.steps += r.block;
         }
-        for _ in 0..rounds {
-            for r in &mut runs {
-                // Untimed: the caches after the other sizes.
-                r.model.advance(&mut r.world, DT_EXACT, 1, &Serial);
-                let e0 = events(&r.model.stats);
-                let start = Instant::now();
-                r.model.advance(&mut r.world, DT_EXACT, r.block, &Serial);
-                r.spent += start.elapsed();
-                r.events += events(&r.model.stats) - e0;
-                r.steps += r.block;
-            }
-        }
-        let rate = |r: &Run| r.events as f64 / r.spent.as_secs_f64();
-        let base = rate(&runs[0]);
-        for r in &runs {
-            let secs = r.spent.as_secs_f64();
-            println!(
-                "exact packing {packing} N {}: load {:.3} s, {:.0} model bytes a sphere, \
-                 {:.0} ns a sphere-step, {:.3} M events/s (10k rate / this: {:.2}), \
-                 {:.0} ns an event, {} events, escaped {}",
-                r.n,
-                r.load,
-                r.bytes,
-                secs / (r.steps as f64 * r.n as f64) * 1e9,
-                rate(r) / 1e6,
-                base / rate(r),
-                secs / r.events as f64 * 1e9,
-                r.events,
-                r.world.escaped()
-            );
-        }
+    }
+    let rate = |r: &Run| r.events as f64 / r.spent.as_secs_f64();
+    let ns = |r: &Run| r.spent.as_secs_f64() / (r.steps as f64 * r.n as f64) * 1e9;
+    let (base_rate, base_ns) = (rate(&runs[0]), ns(&runs[0]));
+    for r in &runs {
+        let heap = r.heap.map_or(String::new(), |h| {
+            format!("{h:.0} model heap bytes a sphere, ")
+        });
+        println!(
+            "{kind} packing {packing} N {}: load {:.3} s, {heap}{:.0} peak bytes a sphere, \
+             {:.0} ns a sphere-step (this / 10k: {:.2}), {:.3} M events/s (10k rate / this: {:.2}), \
+             {} events, escaped {}",
+            r.n,
+            r.load,
+            r.peak,
+            ns(r),
+            ns(r) / base_ns,
+            rate(r) / 1e6,
+            base_rate / rate(r),
+            r.events,
+            r.world.escaped()
+        );
     }
 }
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.first().map(String::as_str) {
-        Some("exact") => return exact_scaling(&args[1..]),
+        Some("exact") => return table(&args[1..], &[ModelKind::Exact]),
+        Some("table") => return table(&args[1..], &ModelKind::ALL),
+        Some("peak") => return peak(&args[1..]),
         Some("exact-one") => return exact_one(&args[1..]),
         Some("exact-renumber") => return exact_renumber(&args[1..]),
         Some("exact-queues") => return exact_queues(&args[1..]),
