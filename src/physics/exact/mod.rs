@@ -265,6 +265,8 @@ impl<Q: EventQueue> EventDriven<Q> {
         self.counts.resize(n, 0);
         self.slots.clear();
         self.slots.resize(n, Slot::default());
+        // The old broad phase goes first, so a rebuild never holds two.
+        self.broad = Broad::default();
         let filled: f64 = self
             .bodies
             .iter()

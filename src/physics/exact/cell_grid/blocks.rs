@@ -4,11 +4,13 @@
 //! fixed-size copy. Walking a linked list instead ends each cell with a
 //! data-dependent branch (how many spheres?) that mispredicts about once per
 //! cell, which measured as the largest cost of a prediction. Most cells are
-//! empty (up to 4 a sphere), so they all name one shared empty block and
-//! only the others have a block of their own, from a pool with a free list:
-//! a cell costs 4 bytes, an occupied one 16 more, and the gather stays
-//! without a branch. The rare spheres beyond [`BLOCK`] in one cell wait in
-//! a map from the cell.
+//! empty (up to 4 a sphere) and most of the others hold one sphere, so a
+//! cell is one word: empty, its lone sphere, or the index of its block in
+//! a pool with a free list. A cell costs 4 bytes, one of two spheres or
+//! more 16 more, and the gather stays without a branch (a lone sphere is
+//! written and counted by its flag, then a block is copied: the shared
+//! empty one unless the cell has its own). The rare spheres beyond
+//! [`BLOCK`] in one cell wait in a map from the cell.
 use std::collections::HashMap;
 
 /// Spheres a cell's block holds (cells are about a diameter wide, so most
@@ -18,14 +20,18 @@ pub const BLOCK: usize = 3;
 const WORDS: usize = BLOCK + 1;
 /// Length of the scratch window the stencils are gathered into.
 const SCRATCH: usize = WINDOW + WORDS;
-/// The block every empty cell names; never written.
+/// The slot of an empty cell, and the block every cell without one of its
+/// own copies (never written).
 const EMPTY: u32 = 0;
+/// Flag of a slot holding a lone sphere (the rest of the word).
+const ONE: u32 = 1 << 31;
 /// End of the free list.
 const NO_BLOCK: u32 = u32::MAX;
 
 #[derive(Clone, Debug, Default)]
 pub struct CellBlocks {
-    /// Per cell: its block in `pool` ([`EMPTY`] when it holds no sphere).
+    /// Per cell: [`EMPTY`], `ONE | sphere` when it holds one, or its block
+    /// in `pool` when it holds more.
     slot: Vec<u32>,
     /// The blocks: the first `BLOCK` spheres, then the count. A free block
     /// links the next free one in its first word.
@@ -36,12 +42,12 @@ pub struct CellBlocks {
 }
 
 impl CellBlocks {
-    /// `cells` empty cells, with room for blocks for up to `spheres` of them
-    /// (reserved, not touched: the pool never needs more, as an occupied
-    /// cell holds a sphere, so it never moves).
+    /// `cells` empty cells, with room for blocks for as many cells as
+    /// `spheres` can fill two at a time (reserved, not touched: the pool
+    /// never needs more, so it never moves).
     pub fn reset(&mut self, spheres: usize, cells: usize) {
         self.slot = vec![EMPTY; cells];
-        self.pool = Vec::with_capacity(spheres.min(cells) + 1);
+        self.pool = Vec::with_capacity((spheres / 2).min(cells) + 1);
         self.pool.push([0; WORDS]);
         self.free = NO_BLOCK;
         self.overflow.clear();
@@ -61,7 +67,18 @@ impl CellBlocks {
         self.slot.len()
     }
 
+    /// A slot read for a gather: its lone sphere (meaningful when the flag
+    /// is 1), that flag, and its block (the empty one but for a cell of
+    /// two spheres or more).
     #[inline(always)]
+    fn parts(&self, s: u32) -> (u32, usize, &[u32; WORDS]) {
+        let one = s >> 31;
+        let block = s & one.wrapping_sub(1);
+        (s & !ONE, one as usize, &self.pool[block as usize])
+    }
+
+    /// Cell `c`'s block (it has one: it holds two spheres or more).
+    #[inline]
     fn block(&self, c: usize) -> &[u32; WORDS] {
         &self.pool[self.slot[c] as usize]
     }
@@ -74,7 +91,14 @@ impl CellBlocks {
     /// Spheres in cell `c`.
     #[inline]
     pub fn count(&self, c: usize) -> u32 {
-        self.block(c)[BLOCK]
+        let (_, one, b) = self.parts(self.slot[c]);
+        one as u32 + b[BLOCK]
+    }
+
+    /// Whether cell `c` holds no sphere.
+    #[inline]
+    pub fn is_empty(&self, c: usize) -> bool {
+        self.slot[c] == EMPTY
     }
 
     #[inline]
@@ -103,25 +127,31 @@ impl CellBlocks {
     /// Put sphere `i` last in cell `c`.
     #[inline]
     pub fn insert(&mut self, i: usize, c: usize) {
-        if self.slot[c] == EMPTY {
+        let s = self.slot[c];
+        if s == EMPTY {
+            self.slot[c] = ONE | i as u32;
+        } else if s & ONE != 0 {
             let b = if self.free == NO_BLOCK {
                 self.pool.push([0; WORDS]);
                 self.pool.len() - 1
             } else {
                 let b = self.free as usize;
                 self.free = self.pool[b][0];
-                self.pool[b] = [0; WORDS];
                 b
             };
+            let mut block = [0; WORDS];
+            (block[0], block[1], block[BLOCK]) = (s & !ONE, i as u32, 2);
+            self.pool[b] = block;
             self.slot[c] = b as u32;
+        } else {
+            let k = self.block(c)[BLOCK] as usize;
+            self.set(c, k, i as u32);
+            self.block_mut(c)[BLOCK] += 1;
         }
-        let k = self.count(c) as usize;
-        self.set(c, k, i as u32);
-        self.block_mut(c)[BLOCK] += 1;
     }
 
-    /// Sphere `i`'s place in cell `c` (a cell holds a few; the rare crowded
-    /// one is searched past its block).
+    /// Sphere `i`'s place in cell `c`, a cell with a block (it holds a few;
+    /// the rare crowded one is searched past its block).
     #[inline]
     fn place(&self, i: usize, c: usize) -> usize {
         let b = self.block(c);
@@ -143,8 +173,14 @@ impl CellBlocks {
     /// fills its place (so every cell keeps the order it had).
     #[inline]
     pub fn remove(&mut self, i: usize, c: usize) {
+        let s = self.slot[c];
+        if s & ONE != 0 {
+            debug_assert_eq!(s & !ONE, i as u32, "cell {c}");
+            self.slot[c] = EMPTY;
+            return;
+        }
         let k = self.place(i, c);
-        let last = self.count(c) as usize - 1;
+        let last = self.block(c)[BLOCK] as usize - 1;
         if k != last {
             let moved = self.get(c, last);
             self.set(c, k, moved);
@@ -157,11 +193,13 @@ impl CellBlocks {
             o.pop();
         }
         self.block_mut(c)[BLOCK] -= 1;
-        if last == 0 {
-            let b = self.slot[c] as usize;
+        if last == 1 {
+            // One sphere left, first in the block: the cell holds it alone.
+            let b = s as usize;
+            let lone = self.pool[b][0];
             self.pool[b][0] = self.free;
             self.free = b as u32;
-            self.slot[c] = EMPTY;
+            self.slot[c] = ONE | lone;
         }
     }
 
@@ -169,7 +207,12 @@ impl CellBlocks {
     /// order.
     pub fn relabel(&mut self, inv: &[u32]) {
         for c in 0..self.slot.len() {
-            if self.slot[c] == EMPTY {
+            let s = self.slot[c];
+            if s & ONE != 0 {
+                self.slot[c] = ONE | inv[(s & !ONE) as usize];
+                continue;
+            }
+            if s == EMPTY {
                 continue;
             }
             let b = self.block_mut(c);
@@ -218,7 +261,9 @@ impl CellBlocks {
         };
         if let Some(window) = window {
             for &o in offsets {
-                let b = self.block(base + o);
+                let (lone, one, b) = self.parts(self.slot[base + o]);
+                window[n & (WINDOW - 1)] = lone;
+                n += one;
                 let at = n & (WINDOW - 1);
                 window[at..at + WORDS].copy_from_slice(b);
                 counts |= b[BLOCK];
@@ -226,7 +271,9 @@ impl CellBlocks {
             }
         } else {
             for &o in offsets {
-                let b = self.block(base + o);
+                let (lone, one, b) = self.parts(self.slot[base + o]);
+                out[n] = lone;
+                n += one;
                 out[n..n + WORDS].copy_from_slice(b);
                 counts |= b[BLOCK];
                 n += (b[BLOCK] as usize).min(BLOCK);
@@ -270,9 +317,11 @@ impl CellBlocks {
         let mut n = 0;
         let mut counts = 0;
         for &o in offsets {
-            let b = &self.pool[slot[o] as usize];
+            let (lone, one, b) = self.parts(slot[o]);
             // Each count is at most BLOCK on this path, so `n` stays within
             // the window; the mask only lets the compiler see that.
+            window[n & (WINDOW - 1)] = lone;
+            n += one;
             let at = n & (WINDOW - 1);
             window[at..at + WORDS].copy_from_slice(b);
             counts |= b[BLOCK];
@@ -304,6 +353,9 @@ mod tests {
         let mut s = CellBlocks::default();
         s.reset(spheres, cells);
         assert_eq!(s.pool.capacity(), cells + 1);
+        s.reset(3, cells);
+        assert_eq!(s.pool.capacity(), 2);
+        s.reset(spheres, cells);
         let mut reference: Vec<Vec<u32>> = vec![Vec::new(); cells];
         let mut out = Vec::new();
         let mut most_blocks = 0;
@@ -339,8 +391,8 @@ mod tests {
                 assert_eq!(out[..n], want[..], "cell {c} after step {step}");
                 assert_eq!(s.count(c) as usize, want.len());
             }
-            // One block an occupied cell, and the empty one.
-            let occupied = reference.iter().filter(|l| !l.is_empty()).count();
+            // One block a cell of two spheres or more, and the empty one.
+            let occupied = reference.iter().filter(|l| l.len() > 1).count();
             most_blocks = most_blocks.max(occupied);
             assert_eq!(s.pool.len(), most_blocks + 1, "step {step}");
             let all = s.gather(0, &(0..cells).collect::<Vec<_>>(), &mut out);

@@ -308,7 +308,7 @@ impl CellGrid {
     ) {
         for c in cells {
             // Most cells are empty (up to 4 a sphere); padding always is.
-            if self.list.count(c) == 0 {
+            if self.list.is_empty(c) {
                 continue;
             }
             let k = self.list.gather_stencil(c, &[0], own);
