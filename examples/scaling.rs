@@ -18,15 +18,20 @@
 //! events (collisions, crossings, walls, relists, stale) per second, and the
 //! 10k rate over that rate. With `renumber` the model sorts its spheres
 //! again as they drift (default: only at load).
-//! `exact-one N packing steps [dt] [renumber]` runs one size only (for
-//! callgrind); with `renumber` the model sorts its spheres again as they
-//! drift.
+//! `exact-one N packing steps [dt] [renumber] [calendar]` runs one size only
+//! (for callgrind); with `renumber` the model sorts its spheres again as
+//! they drift, with `calendar` it runs over the calendar queue.
 //! `exact-renumber N packing rounds [steps]`: one scene, two models, one
 //! relabelling its spheres in space as they drift (the default) and one
 //! keeping the load's order, run side by side on copies of the world in
 //! blocks of `steps` steps of 2 ms (default 20), timed in alternation:
 //! events per second of each, per round, as the spheres drift from where
 //! the load sorted them.
+//! `exact-queues N packing rounds [steps]`: one scene, the exact model over
+//! its two event queues (tournament tree, calendar), on copies of the world
+//! in blocks of `steps` steps of 2 ms (default 20), timed in alternation:
+//! events per second of each, and each queue's heap bytes a sphere. The
+//! two must process the same events: the counts are compared at the end.
 //!
 //! With `sorted`, both worlds are sorted in space (by cell of the 10k
 //! scene's grid, z then y then x) before every block, outside the timing:
@@ -34,7 +39,7 @@
 //! itself never reorders the world (the screen, the CSV and the model
 //! comparisons read spheres by index).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap fails the run
-use ballpit::physics::exact::{EventStats, Exact};
+use ballpit::physics::exact::{Calendar, EventDriven, EventQueue, EventStats, Exact, Tournament};
 use ballpit::physics::sphere::volume;
 use ballpit::physics::{Model, ModelKind, Serial, World};
 use ballpit::scene::{SceneSpec, build_world};
@@ -87,6 +92,14 @@ fn events(s: &EventStats) -> u64 {
 }
 
 fn exact_one(args: &[String]) {
+    if args.iter().any(|a| a == "calendar") {
+        exact_one_with(args, EventDriven::<Calendar>::default());
+    } else {
+        exact_one_with(args, EventDriven::<Tournament>::default());
+    }
+}
+
+fn exact_one_with<Q: EventQueue + Send>(args: &[String], model: EventDriven<Q>) {
     let num = |k: usize| args.get(k).and_then(|a| a.parse::<f64>().ok());
     let (n, packing, steps) = (
         num(0).expect("N") as usize,
@@ -97,7 +110,7 @@ fn exact_one(args: &[String]) {
     let mut world = exact_scene(n, packing);
     let (scene_peak, scene_rss) = (status_kib("VmHWM"), status_kib("VmRSS"));
     let renumber = args.iter().any(|a| a == "renumber");
-    let mut model = Exact::default().with_renumbering(renumber);
+    let mut model = model.with_renumbering(renumber);
     let start = Instant::now();
     model.advance(&mut world, 1e-9, 1, &Serial);
     let load = start.elapsed();
@@ -110,9 +123,13 @@ fn exact_one(args: &[String]) {
     let ev = events(&model.stats) - e0;
     let per = |kib: u64| (kib.saturating_sub(empty) * 1024) as f64 / n.max(1) as f64;
     println!(
-        "{n} spheres, packing {packing}: load {:.3} s, model heap {} bytes a sphere; \
+        "{n} spheres, packing {packing}, {}: load {:.3} s, model heap {} bytes a sphere; \
          RSS a sphere: {:.0} after the scene (peak {:.0}), {:.0} after the steps (peak {:.0}); \
          {ev} events, {:.3} M/s ({:?})",
+        std::any::type_name::<Q>()
+            .rsplit("::")
+            .next()
+            .unwrap_or("?"),
         load.as_secs_f64(),
         model.heap_bytes() / n.max(1),
         per(scene_rss),
@@ -177,6 +194,84 @@ fn exact_renumber(args: &[String]) {
         events(&runs[0].2.stats) - e0,
         total[0] as f64 / spent[0] / 1e6,
         total[1] as f64 / spent[1] / 1e6
+    );
+}
+
+/// One untimed step (the caches after the other model), then `steps` timed:
+/// the events processed and the seconds.
+fn timed_block<Q: EventQueue + Send>(
+    m: &mut EventDriven<Q>,
+    w: &mut World,
+    steps: u64,
+) -> (u64, f64) {
+    m.advance(w, DT_EXACT, 1, &Serial);
+    let before = events(&m.stats);
+    let start = Instant::now();
+    m.advance(w, DT_EXACT, steps, &Serial);
+    (events(&m.stats) - before, start.elapsed().as_secs_f64())
+}
+
+fn exact_queues(args: &[String]) {
+    let num = |k: usize| args.get(k).and_then(|a| a.parse::<f64>().ok());
+    let (n, packing, rounds) = (
+        num(0).expect("N") as usize,
+        num(1).expect("packing"),
+        num(2).expect("rounds") as usize,
+    );
+    let steps = num(3).map_or(20, |s| s as u64);
+    let world = exact_scene(n, packing);
+    let (mut wt, mut wc) = (world.clone(), world);
+    let mut tree = EventDriven::<Tournament>::default();
+    let mut cal = EventDriven::<Calendar>::default();
+    tree.advance(&mut wt, 1e-9, 1, &Serial);
+    cal.advance(&mut wc, 1e-9, 1, &Serial);
+    let (mut total, mut spent) = ([0u64; 2], [0f64; 2]);
+    for round in 0..rounds {
+        // Which goes first alternates too.
+        let order = if round % 2 == 0 { [0, 1] } else { [1, 0] };
+        let mut rates = [0.0; 2];
+        for k in order {
+            let (ev, secs) = if k == 0 {
+                timed_block(&mut tree, &mut wt, steps)
+            } else {
+                timed_block(&mut cal, &mut wc, steps)
+            };
+            total[k] += ev;
+            spent[k] += secs;
+            rates[k] = ev as f64 / secs / 1e6;
+        }
+        let rate = |k: usize| total[k] as f64 / spent[k];
+        println!(
+            "round {round}: tournament {:.3} M events/s, calendar {:.3} M events/s; \
+             so far calendar/tournament {:.3}",
+            rates[0],
+            rates[1],
+            rate(1) / rate(0)
+        );
+    }
+    assert_eq!(
+        tree.stats, cal.stats,
+        "the two queues processed different events"
+    );
+    assert!(
+        wt.spheres
+            .iter()
+            .zip(&wc.spheres)
+            .all(|(a, b)| a.pos == b.pos && a.vel == b.vel),
+        "the two queues left different worlds"
+    );
+    println!(
+        "exact-queues N {n} packing {packing}: {} events a model; tournament {:.3} M/s, \
+         calendar {:.3} M/s, calendar/tournament {:.3}; queue heap bytes a sphere: \
+         tournament {:.1}, calendar {:.1}; model heap bytes a sphere: tournament {:.0}, calendar {:.0}",
+        total[0],
+        total[0] as f64 / spent[0] / 1e6,
+        total[1] as f64 / spent[1] / 1e6,
+        (total[1] as f64 / spent[1]) / (total[0] as f64 / spent[0]),
+        tree.queue_heap_bytes() as f64 / n as f64,
+        cal.queue_heap_bytes() as f64 / n as f64,
+        tree.heap_bytes() as f64 / n as f64,
+        cal.heap_bytes() as f64 / n as f64,
     );
 }
 
@@ -277,6 +372,7 @@ fn main() {
         Some("exact") => return exact_scaling(&args[1..]),
         Some("exact-one") => return exact_one(&args[1..]),
         Some("exact-renumber") => return exact_renumber(&args[1..]),
+        Some("exact-queues") => return exact_queues(&args[1..]),
         _ => {}
     }
     let sorted = args.iter().any(|a| a == "sorted");

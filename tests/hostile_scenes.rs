@@ -227,6 +227,12 @@ fn a_heap_of_overlapping_spheres_under_discrete_neither_fills_memory_nor_hangs()
         j["warnings"][0].as_str().unwrap().contains("work budget"),
         "{j}"
     );
+    // The overlap readout stops at the same budget and says so.
+    assert!(
+        j["warnings"][1].as_str().unwrap().contains("a lower bound"),
+        "{j}"
+    );
+    assert!(j["max_overlap_rel"].as_f64().unwrap() > 0.5, "{j}");
     let rss = j["peak_rss_bytes"].as_u64().unwrap();
     assert!(rss < 1 << 30, "peak {rss} bytes");
 }

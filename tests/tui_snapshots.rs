@@ -178,6 +178,24 @@ fn readouts_panel_says_when_the_work_budget_was_hit() {
 }
 
 #[test]
+fn readouts_panel_marks_an_overlap_readout_cut_at_its_budget_as_a_lower_bound() {
+    let mut snap = snapshot();
+    snap.max_overlap_rel = 1.5;
+    let text = |snap: &ballpit::engine::Snapshot| {
+        format!(
+            "{:?}",
+            readouts(&state(), snap, Palette::C16).backend().buffer()
+        )
+    };
+    let whole = text(&snap);
+    assert!(whole.contains("overlap    1.5e0 "), "{whole}");
+    assert!(!whole.contains('≥'), "{whole}");
+    snap.overlap_partial = true;
+    let cut = text(&snap);
+    assert!(cut.contains("overlap    ≥1.5e0"), "{cut}");
+}
+
+#[test]
 fn readouts_panel_says_exact_runs_on_one_thread_in_pool_mode() {
     let mut st = state();
     st.threading = Threading::Pool;

@@ -1,7 +1,7 @@
 //! One frame's worth of work, moved whole to whichever thread runs it: the
 //! world, the model, the executor, and the back snapshot to fill.
 use super::Settings;
-use super::snapshot::{OverlapScratch, Snapshot};
+use super::snapshot::{Overlap, OverlapScratch, Snapshot};
 use crate::physics::{Exec, Model, World};
 use std::sync::Arc;
 use std::time::Instant;
@@ -68,7 +68,10 @@ impl Frame {
         let overlap = self
             .model
             .max_overlap_rel(&self.world, self.settings.dt, &*self.exec)
-            .unwrap_or_else(|| self.scratch.max_overlap_rel(&self.world, &*self.exec));
+            .map_or_else(
+                || self.scratch.measure(&self.world, &*self.exec),
+                Overlap::complete,
+            );
         let physics_seconds = t0.elapsed().as_secs_f64();
         self.number += 1;
         let snap = &mut self.snap;

@@ -1,7 +1,8 @@
 //! What the screen reads of a finished frame. Two of them exist: the front
 //! one the renderer reads while the physics fills the back one.
 use super::Settings;
-use crate::physics::broad::{Grid, Pair};
+use crate::physics::broad::Grid;
+use crate::physics::discrete::pair_budget;
 use crate::physics::exec::{for_each_block, for_each_chunk};
 use crate::physics::world::escapes;
 use crate::physics::{Counters, Exec, World};
@@ -36,6 +37,10 @@ pub struct Snapshot {
     /// Energy right after the last reset (or scene start), for the drift.
     pub energy_reset: f64,
     pub max_overlap_rel: f64,
+    /// The overlap readout stopped at its pair budget (a heap of
+    /// overlapping spheres): `max_overlap_rel` is the deepest among the
+    /// pairs it looked at, a lower bound.
+    pub overlap_partial: bool,
     pub escaped: usize,
     pub counters: Counters,
     /// Parts the model cut its last step into (1: whole).
@@ -69,6 +74,7 @@ impl Snapshot {
             energy: 0.0,
             energy_reset,
             max_overlap_rel: 0.0,
+            overlap_partial: false,
             escaped: 0,
             counters: Counters::default(),
             parts: 1,
@@ -78,7 +84,7 @@ impl Snapshot {
             notice: None,
         };
         let serial = crate::physics::Serial;
-        let overlap = OverlapScratch::default().max_overlap_rel(world, &serial);
+        let overlap = OverlapScratch::default().measure(world, &serial);
         s.fill_world(world, 1, overlap, &serial, views);
         s
     }
@@ -90,7 +96,7 @@ impl Snapshot {
         &mut self,
         world: &World,
         parts: u32,
-        max_overlap_rel: f64,
+        overlap: Overlap,
         exec: &dyn Exec,
         views: bool,
     ) {
@@ -136,7 +142,8 @@ impl Snapshot {
         self.max_radius = (!sp.is_empty()).then(|| f64::from_bits(widest.into_inner()));
         self.energy = world.kinetic_energy();
         self.parts = parts;
-        self.max_overlap_rel = max_overlap_rel;
+        self.max_overlap_rel = overlap.deepest_rel;
+        self.overlap_partial = overlap.partial;
         self.escaped = escaped.into_inner();
         self.counters = world.counters;
     }
@@ -151,20 +158,49 @@ impl Snapshot {
     }
 }
 
+/// The overlap readout of a frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Overlap {
+    /// Deepest pair overlap over the smaller radius.
+    pub deepest_rel: f64,
+    /// Only some overlapping pairs were looked at: `deepest_rel` is a lower bound.
+    pub partial: bool,
+}
+
+impl Overlap {
+    /// A readout that looked at every pair.
+    pub fn complete(deepest_rel: f64) -> Overlap {
+        Overlap {
+            deepest_rel,
+            partial: false,
+        }
+    }
+}
+
 /// A grid kept between frames for the overlap check, searched on the
 /// frame's executor (`World::max_overlap_rel` would rebuild it serially).
 #[derive(Default)]
 pub(crate) struct OverlapScratch {
     grid: Grid,
-    /// Stays empty: no pair is kept.
-    none: Vec<Pair>,
 }
 
 impl OverlapScratch {
-    /// Same value as `World::max_overlap_rel`: the max is order-free. The
-    /// pairs are looked at, never kept: a heap of overlapping spheres (a
-    /// `discrete` scene from a file) has more of them than memory holds.
-    pub(crate) fn max_overlap_rel(&mut self, world: &World, exec: &dyn Exec) -> f64 {
+    /// The deepest overlap, looking at no more overlapping pairs than a
+    /// `discrete` step may answer ([`pair_budget`]).
+    pub(crate) fn measure(&mut self, world: &World, exec: &dyn Exec) -> Overlap {
+        self.measure_within(world, exec, pair_budget(world.spheres.len()))
+    }
+
+    /// Same value as `World::max_overlap_rel` while at most `limit` pairs
+    /// overlap (the max is order-free). The pairs are looked at, never
+    /// kept; past `limit` the readout stops, so a heap of overlapping
+    /// spheres (a file scene) costs a frame no more than a step may.
+    pub(crate) fn measure_within(
+        &mut self,
+        world: &World,
+        exec: &dyn Exec,
+        limit: usize,
+    ) -> Overlap {
         let sp = &world.spheres;
         self.grid.build(sp, world.size, |s| (s.pos, s.radius), exec);
         // Depths are never negative, and such f64s order as their bits.
@@ -178,10 +214,64 @@ impl OverlapScratch {
                     let rel = depth / a.radius.min(b.radius);
                     worst.fetch_max(rel.to_bits(), Ordering::Relaxed);
                 }
+                return true;
             }
             false
         };
-        self.grid.pairs(exec, &deepest, &mut self.none);
-        f64::from_bits(worst.into_inner())
+        let all = self.grid.count_within(exec, &deepest, limit);
+        Overlap {
+            deepest_rel: f64::from_bits(worst.into_inner()),
+            partial: !all,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::{Serial, Sphere};
+    use glam::DVec3;
+
+    /// `n` spheres of radius 0.01 within 1e-3 of the centre: every pair
+    /// overlaps, by different depths.
+    fn heap(n: u32) -> World {
+        let spheres = (0..n)
+            .map(|i| {
+                let d = |k: u32| f64::from((i.wrapping_mul(2_654_435_761) >> k) % 1000) * 1e-6;
+                Sphere {
+                    pos: DVec3::new(0.5 + d(0), 0.5 + d(10), 0.5 + d(20)),
+                    vel: DVec3::ZERO,
+                    radius: 0.01,
+                    mass: 1.0,
+                }
+            })
+            .collect();
+        World::new(1.0, spheres)
+    }
+
+    #[test]
+    fn the_readout_within_its_budget_is_the_brute_force_value() {
+        let world = heap(60); // 1 770 overlapping pairs
+        let full = world.max_overlap_rel();
+        assert!(full > 0.5, "{full}");
+        let mut s = OverlapScratch::default();
+        for limit in [1_770, 1_771, usize::MAX / 2] {
+            let o = s.measure_within(&world, &Serial, limit);
+            assert_eq!(o, Overlap::complete(full), "limit {limit}");
+        }
+    }
+
+    #[test]
+    fn past_its_budget_the_readout_stops_and_says_it_gives_a_lower_bound() {
+        let world = heap(60);
+        let full = world.max_overlap_rel();
+        let o = OverlapScratch::default().measure_within(&world, &Serial, 1_769);
+        assert!(o.partial);
+        assert!(
+            o.deepest_rel > 0.0 && o.deepest_rel <= full,
+            "{o:?} vs {full}"
+        );
+        let o = OverlapScratch::default().measure_within(&world, &Serial, 10);
+        assert!(o.partial && o.deepest_rel <= full, "{o:?}");
     }
 }

@@ -17,6 +17,12 @@ use super::world::World;
 const PAIRS_BASE: usize = 20_000_000;
 const PAIRS_PER_SPHERE: usize = 100;
 
+/// The overlapping pairs a step of `n` spheres may answer; the engine's
+/// overlap readout looks at no more either.
+pub fn pair_budget(n: usize) -> usize {
+    PAIRS_BASE.saturating_add(PAIRS_PER_SPHERE.saturating_mul(n))
+}
+
 #[derive(Default)]
 pub struct Discrete {
     detect: Detection,
@@ -53,7 +59,7 @@ impl Discrete {
         };
         // Sphere–sphere work (which pairs overlap) beside sphere–wall work
         // (which spheres are past a wall).
-        self.detect.pair_limit = Some(PAIRS_BASE.saturating_add(PAIRS_PER_SPHERE * sp.len()));
+        self.detect.pair_limit = Some(pair_budget(sp.len()));
         self.detect
             .run(exec, sp, size, |s| (s.pos, s.radius), &overlapping, &|s| {
                 outside(s, size)

@@ -156,10 +156,7 @@ impl Readouts<'_> {
             ),
             row(
                 "overlap",
-                format!(
-                    "{:<8.1e} deepest/r  escaped {}",
-                    snap.max_overlap_rel, snap.escaped
-                ),
+                format!("{:<8} deepest/r  escaped {}", overlap(snap), snap.escaped),
             ),
             row(
                 "collisions",
@@ -225,7 +222,7 @@ impl Readouts<'_> {
                 "drift",
                 format!("{:.1e}", snap.energy_drift()),
                 "overlap",
-                format!("{:.1e} esc {}", snap.max_overlap_rel, snap.escaped),
+                format!("{} esc {}", overlap(snap), snap.escaped),
             ),
             pair(
                 "steps",
@@ -312,4 +309,11 @@ pub fn human_bytes(b: u64) -> String {
     } else {
         format!("{:.1} MB", b as f64 / 1e6)
     }
+}
+
+/// The deepest overlap; "≥" when the readout stopped at its pair budget
+/// (a heap of overlapping spheres) and so gives a lower bound.
+fn overlap(snap: &Snapshot) -> String {
+    let at_least = if snap.overlap_partial { "≥" } else { "" };
+    format!("{at_least}{:.1e}", snap.max_overlap_rel)
 }

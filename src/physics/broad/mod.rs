@@ -24,7 +24,7 @@ const CROSS_BLOCK: usize = 64;
 const LANES_MIN_SPHERES: usize = 4096;
 /// Spheres per parallel block while binning.
 const BUILD_BLOCK: usize = 4096;
-/// Pairs a unit of [`Grid::pairs_within`] finds before it adds them to the
+/// Pairs a unit of [`Grid::pairs_within`] (or [`Grid::count_within`]) finds before it adds them to the
 /// shared total.
 const LIMIT_FLUSH: usize = 256;
 /// The first level's cell comes from every this-many-th reach.
@@ -407,15 +407,47 @@ impl Grid {
             return true;
         }
         out.clear();
+        let (all, units) = self.scan_within::<true, K>(exec, keep, limit);
+        if all {
+            for s in &self.slots[..units] {
+                out.extend_from_slice(&s.lock());
+            }
+        }
+        all
+    }
+
+    /// Looks at the pairs within reach, keeping none, until more than
+    /// `limit` of them were `counted`: true if every pair was looked at.
+    /// For a readout that must not cost more than a step may.
+    pub fn count_within<K: Fn(u32, u32) -> bool + Sync>(
+        &mut self,
+        exec: &dyn Exec,
+        counted: &K,
+        limit: usize,
+    ) -> bool {
+        self.scan_within::<false, K>(exec, counted, limit).0
+    }
+
+    /// The pairs within reach, unit by unit, the ones `keep` accepts
+    /// counted (and, if `STORE`, left in the unit's slot) until more than
+    /// `limit` were; false then. Also returns the number of units.
+    fn scan_within<const STORE: bool, K: Fn(u32, u32) -> bool + Sync>(
+        &mut self,
+        exec: &dyn Exec,
+        keep: &K,
+        limit: usize,
+    ) -> (bool, usize) {
         let units = self.units();
-        while self.slots.len() < units.len() {
+        while STORE && self.slots.len() < units.len() {
             self.slots.push(Mutex::new(Vec::new()));
         }
         let this = &*self;
         let found = AtomicUsize::new(0);
         for_each_block(exec, units.len(), &|u| {
-            let mut v = this.slots[u].lock();
-            v.clear();
+            let mut v = STORE.then(|| this.slots[u].lock());
+            if let Some(v) = &mut v {
+                v.clear();
+            }
             // Counted here, added to the total now and then: one shared
             // counter touched per pair would cost more than the pair.
             // The total is read then too: a unit that finds few pairs costs
@@ -437,20 +469,16 @@ impl Grid {
             if go() {
                 this.unit_pairs(units[u], &go, &mut |i, j| {
                     if keep(i, j) {
-                        v.push((i, j));
+                        if let Some(v) = &mut v {
+                            v.push((i, j));
+                        }
                         mine.set(mine.get() + 1);
                     }
                 });
             }
             tell();
         });
-        if found.into_inner() > limit {
-            return false;
-        }
-        for s in &self.slots[..units.len()] {
-            out.extend_from_slice(&s.lock());
-        }
-        true
+        (found.into_inner() <= limit, units.len())
     }
 
     /// Every sphere whose ball may meet a ball of radius `reach` around `p`,

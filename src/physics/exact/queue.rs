@@ -1,6 +1,7 @@
-//! The event queue: one pending event per sphere ([`EventQueue`]), and the
-//! one implementation, a tournament tree ([`Tournament`]: a complete binary
-//! tree whose every inner node holds the earlier of its two children).
+//! The event queue: one pending event per sphere ([`EventQueue`]), and a
+//! tournament tree ([`Tournament`]: a complete binary tree whose every inner
+//! node holds the earlier of its two children); the bucket queue is
+//! [`super::calendar::Calendar`].
 //! `DynamO` and Smallenburg's EDMD also keep one event per particle; the tree
 //! makes "replace sphere i's event" and "peek the earliest" O(log N) and
 //! O(1) with no allocation and no stale entries, which a binary heap of all
@@ -8,7 +9,10 @@
 
 /// The earliest of one pending event time per sphere. Simultaneous events
 /// pop in sphere-index order (lower index first): the fixed order that makes
-/// runs reproducible, so another queue must keep it to give the same runs.
+/// runs reproducible, so another queue must keep it to give the same runs:
+/// [`Self::peek`] is the least `(time, sphere)` over every sphere, ties of
+/// `+inf` included (and `(+inf, u32::MAX)` with no spheres). Times are not
+/// `NaN`s without the sign bit (those sort after `+inf`).
 pub trait EventQueue: Default {
     /// Spheres `0..n`, every event at infinity.
     fn reset(&mut self, n: usize);
@@ -25,7 +29,8 @@ pub trait EventQueue: Default {
         self.update(j, tj);
     }
     /// The earliest pending event: time and sphere (time infinite if none).
-    fn peek(&self) -> (f64, usize);
+    /// Mutable, so a queue may sort lazily.
+    fn peek(&mut self) -> (f64, usize);
     /// Time of sphere `i`'s pending event.
     fn time_of(&self, i: usize) -> f64;
     /// Subtract `shift` from every time (a new time origin).
@@ -39,13 +44,13 @@ pub trait EventQueue: Default {
 /// which LLVM keeps as a conditional move where a select on two `f64`s
 /// became a random branch.
 #[inline(always)]
-fn key(t: f64) -> u64 {
+pub(super) fn key(t: f64) -> u64 {
     let bits = (t + 0.0).to_bits();
     bits ^ ((((bits as i64) >> 63) as u64) | (1 << 63))
 }
 
 #[inline(always)]
-fn time(key: u64) -> f64 {
+pub(super) fn time(key: u64) -> f64 {
     f64::from_bits(key ^ (!(((key as i64) >> 63) as u64) | (1 << 63)))
 }
 
@@ -88,13 +93,18 @@ impl EventQueue for Tournament {
         self.keys.capacity() * 8 + self.ids.capacity() * 4
     }
 
-    /// A queue for spheres `0..n`, every event at infinity.
+    /// A queue for spheres `0..n`, every event at infinity (each leaf holds
+    /// its sphere, so ties at infinity go to the lowest index too).
     fn reset(&mut self, n: usize) {
         self.size = n.next_power_of_two().max(1);
         self.keys.clear();
         self.keys.resize(2 * self.size, key(f64::INFINITY));
         self.ids.clear();
         self.ids.resize(2 * self.size, u32::MAX);
+        for (i, id) in self.ids[self.size..self.size + n].iter_mut().enumerate() {
+            *id = i as u32;
+        }
+        self.rebuild();
     }
 
     /// Set the leaves without rebuilding the tree; call [`Self::rebuild`] after.
@@ -164,7 +174,7 @@ impl EventQueue for Tournament {
 
     /// The earliest pending event: time and sphere (time infinite if none).
     #[inline]
-    fn peek(&self) -> (f64, usize) {
+    fn peek(&mut self) -> (f64, usize) {
         (time(self.keys[1]), self.ids[1] as usize)
     }
 
