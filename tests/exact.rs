@@ -311,3 +311,43 @@ fn renumbering_in_space_changes_nothing_but_labels() {
         }
     }
 }
+
+/// What exact holds a sphere besides its bodies and its queue (issue 20):
+/// the cell grid (4 cells a sphere at most, each one word; a block only for
+/// a cell of two spheres or more; each sphere's packed cell) and a 20-byte
+/// slot. Before, the grid alone took 16 bytes a cell and 14 a sphere (about
+/// 85 a sphere), the event and pending records 36.
+#[test]
+fn the_cell_grid_and_the_event_slots_stay_small() {
+    use ballpit::physics::exact::body::Body;
+    use ballpit::physics::exact::cell_grid::{CELLS_PER_SPHERE, CellGrid};
+    use ballpit::physics::exact::schedule::Slot;
+    use ballpit::scene::{SceneSpec, build_world};
+    assert_eq!(size_of::<Slot>(), 20);
+    for radius in [0.002_285_39, 0.006_19] {
+        // 100k spheres at packing 0.005 and 0.1.
+        let w = build_world(&SceneSpec {
+            count: Some(100_000),
+            radius: Some(radius),
+            seed: Some(5),
+            ..Default::default()
+        })
+        .unwrap();
+        let bodies: Vec<Body> = w
+            .spheres
+            .iter()
+            .map(|s| Body::from_sphere(s, 0.0))
+            .collect();
+        let mut grid = CellGrid::default();
+        grid.build(&bodies, w.size, CELLS_PER_SPHERE);
+        let cells = grid.cells() as f64 / bodies.len() as f64;
+        let per = grid.heap_bytes() as f64 / bodies.len() as f64;
+        // The cells the spheres make: at least 3 a sphere (the cap is 4),
+        // so a word a cell would be out of reach if cells were blocks.
+        assert!(cells > 3.0 && cells < 4.5, "{cells} cells a sphere");
+        assert!(
+            per < 4.0 * cells + 8.0,
+            "{per} bytes a sphere, {cells} cells"
+        );
+    }
+}

@@ -45,6 +45,7 @@ pub mod body;
 pub mod calendar;
 pub mod cell_grid;
 pub mod large;
+pub mod masses;
 pub mod neighbour_lists;
 mod overlap;
 pub mod queue;
@@ -60,9 +61,10 @@ use body::Body;
 pub use calendar::Calendar;
 use cell_grid::CellGrid;
 use glam::DVec3;
+use masses::Masses;
 use neighbour_lists::NeighbourLists;
 pub use queue::{EventQueue, Tournament};
-use schedule::{Event, Kind, Predictor};
+use schedule::{Event, Kind, Predictor, Slot};
 
 /// Events (contacts, wall hits, relists, stale predictions) a step may take,
 /// at least; scenes add [`EVENT_CAP_PER_SPHERE`] per sphere.
@@ -121,16 +123,16 @@ pub type Exact = EventDriven<Tournament>;
 #[derive(Default)]
 pub struct EventDriven<Q: EventQueue> {
     bodies: Vec<Body>,
-    mass: Vec<f64>,
+    mass: Masses,
     /// World index of each body: bodies are kept in a spatial order (sorted
     /// by cell when loaded), so neighbours sit close in memory and a
     /// prediction touches few cache lines.
     order: Vec<u32>,
     counts: Vec<u32>,
-    events: Vec<Event>,
-    /// Cell mode: each sphere's best contact or wall event (absolute time),
-    /// kept apart from its crossing so a crossing rescans only new cells.
-    pending: Vec<(f64, Event)>,
+    /// Each sphere's event; in cell mode its best contact or wall event
+    /// (absolute time), kept apart from its crossing so a crossing rescans
+    /// only new cells, and which of the two the queue holds.
+    slots: Vec<Slot>,
     queue: Q,
     broad: Broad,
     /// Scratch for the candidates a prediction gathers.
@@ -208,10 +210,9 @@ impl<Q: EventQueue> EventDriven<Q> {
             Broad::Cells(cells) => cells.heap_bytes(),
         };
         self.bodies.capacity() * size_of::<Body>()
-            + self.mass.capacity() * 8
+            + self.mass.heap_bytes()
             + (self.order.capacity() + self.counts.capacity() + self.candidates.capacity()) * 4
-            + self.events.capacity() * size_of::<Event>()
-            + self.pending.capacity() * size_of::<(f64, Event)>()
+            + self.slots.capacity() * size_of::<Slot>()
             + self.queue.heap_bytes()
             + broad
     }
@@ -236,10 +237,13 @@ impl<Q: EventQueue> EventDriven<Q> {
                 .order
                 .iter()
                 .zip(&self.bodies)
-                .zip(&self.mass)
-                .all(|((&k, b), &m)| {
+                .enumerate()
+                .all(|(i, (&k, b))| {
                     let s = &world.spheres[k as usize];
-                    s.pos == b.pos && s.vel == b.vel && s.radius == b.radius && s.mass == m
+                    s.pos == b.pos
+                        && s.vel == b.vel
+                        && s.radius == b.radius
+                        && s.mass == self.mass.get(i)
                 })
     }
 
@@ -255,9 +259,7 @@ impl<Q: EventQueue> EventDriven<Q> {
                 .iter()
                 .map(|&k| Body::from_sphere(&world.spheres[k as usize], 0.0)),
         );
-        self.mass.clear();
-        self.mass
-            .extend(self.order.iter().map(|&k| world.spheres[k as usize].mass));
+        self.mass = Masses::new(self.order.iter().map(|&k| world.spheres[k as usize].mass));
         self.sorted_at = self.stats.crossings + self.stats.relists;
         self.reschedule_all();
     }
@@ -269,9 +271,10 @@ impl<Q: EventQueue> EventDriven<Q> {
         let n = self.bodies.len();
         self.counts.clear();
         self.counts.resize(n, 0);
-        self.events.clear();
-        self.events.resize(n, Event::default());
-        self.pending.clear();
+        self.slots.clear();
+        self.slots.resize(n, Slot::default());
+        // The old broad phase goes first, so a rebuild never holds two.
+        self.broad = Broad::default();
         let filled: f64 = self
             .bodies
             .iter()
@@ -281,10 +284,7 @@ impl<Q: EventQueue> EventDriven<Q> {
             let mut nl = Box::<NeighbourLists>::default();
             nl.build(&self.bodies, self.size);
             self.broad = Broad::Lists(nl);
-            // Only cells keep a pending event apart from the broad phase's.
-            self.pending = Vec::new();
         } else {
-            self.pending.resize(n, (f64::INFINITY, Event::default()));
             let mut cells = Box::<CellGrid>::default();
             let per_sphere = self.cells_per_sphere.unwrap_or(cell_grid::CELLS_PER_SPHERE);
             cells.build(&self.bodies, self.size, per_sphere);
@@ -292,18 +292,16 @@ impl<Q: EventQueue> EventDriven<Q> {
         }
         self.queue.reset(n);
         for i in 0..n {
-            let (t, ev) = self.predict(i);
-            self.events[i] = ev;
+            let t = self.predict(i);
             self.queue.set_leaf(i, t);
         }
         self.queue.rebuild();
         self.valid = true;
     }
 
-    /// Sphere `i`'s next event (absolute time); in cell mode also records
-    /// its best non-crossing event in `pending`.
+    /// Sphere `i`'s next event, into its slot; returns its absolute time.
     #[inline]
-    fn predict(&mut self, i: usize) -> (f64, Event) {
+    fn predict(&mut self, i: usize) -> f64 {
         let a = &self.bodies[i];
         match &self.broad {
             Broad::Lists(nl) => {
@@ -316,7 +314,9 @@ impl<Q: EventQueue> EventDriven<Q> {
                 for l in nl.of(i) {
                     p.pair(l.j);
                 }
-                p.finish()
+                let (t, ev) = p.finish();
+                self.slots[i] = Slot { t, ev };
+                t
             }
             Broad::Cells(cells) => {
                 let idle = Event::default();
@@ -334,33 +334,36 @@ impl<Q: EventQueue> EventDriven<Q> {
                         p.pair(j);
                     }
                 }
-                self.pending[i] = p.finish();
+                let (t, ev) = p.finish();
+                self.slots[i] = Slot { t, ev };
                 self.with_crossing(i)
             }
         }
     }
 
     /// Cell mode: the earlier of the pending event and the next crossing
-    /// (the crossing first on a tie).
+    /// (the crossing first on a tie), marked in the slot; returns its time.
     #[inline]
-    fn with_crossing(&self, i: usize) -> (f64, Event) {
+    fn with_crossing(&mut self, i: usize) -> f64 {
         let Broad::Cells(cells) = &self.broad else {
             unreachable!("crossings only in cell mode")
         };
         let a = &self.bodies[i];
         let (tc, ev) = cells.next_event(i, a);
         let tc = a.t + tc;
-        let (tp, evp) = self.pending[i];
+        let slot = &mut self.slots[i];
+        let tp = slot.t;
         // By index: which comes first is random, and a branch on it
         // mispredicted a third of the time.
-        let first = (tc <= tp) as usize;
-        ([tp, tc][first], [evp, ev][first])
+        let first = tc <= tp;
+        let broad = 8 | ev.mask | u8::from(ev.kind == Kind::Relist) << 4;
+        slot.ev.cross = [0, broad][usize::from(first)];
+        [tp, tc][usize::from(first)]
     }
 
     #[inline]
     fn schedule(&mut self, i: usize) {
-        let (t, ev) = self.predict(i);
-        self.events[i] = ev;
+        let t = self.predict(i);
         self.queue.update(i, t);
     }
 
@@ -368,7 +371,7 @@ impl<Q: EventQueue> EventDriven<Q> {
     /// still holds unless its partner has moved on; only the new layer of
     /// cells needs checking.
     fn after_crossing(&mut self, i: usize, mask: u8) {
-        let (tp, evp) = self.pending[i];
+        let (tp, evp) = self.slots[i].pending();
         if evp.kind == Kind::Pair && self.counts[evp.partner as usize] != evp.partner_count {
             self.schedule(i);
             return;
@@ -382,9 +385,9 @@ impl<Q: EventQueue> EventDriven<Q> {
         for &j in &self.candidates[..n] {
             p.pair(j);
         }
-        self.pending[i] = p.finish();
-        let (t, ev) = self.with_crossing(i);
-        self.events[i] = ev;
+        let (t, ev) = p.finish();
+        self.slots[i] = Slot { t, ev };
+        let t = self.with_crossing(i);
         self.queue.update(i, t);
     }
 
@@ -399,8 +402,9 @@ impl<Q: EventQueue> EventDriven<Q> {
             b.t = 0.0;
         }
         self.queue.shift(now);
-        for p in &mut self.pending {
-            p.0 -= now;
+        // Only cell mode keeps times in the slots; lists' are unused.
+        for p in &mut self.slots {
+            p.t -= now;
         }
         self.origin = world_time;
     }
@@ -421,7 +425,7 @@ impl<Q: EventQueue> EventDriven<Q> {
                 return false;
             }
             done += 1;
-            let ev = self.events[i];
+            let ev = self.slots[i].queued();
             self.bodies[i].advance(t);
             match ev.kind {
                 Kind::Pair => {
@@ -434,16 +438,14 @@ impl<Q: EventQueue> EventDriven<Q> {
                     self.stats.pairs += 1;
                     self.bodies[j].advance(t);
                     self.collide(i, j, c);
-                    let (ti, evi) = self.predict(i);
-                    let (tj, evj) = self.predict(j);
-                    self.events[i] = evi;
-                    self.events[j] = evj;
+                    let ti = self.predict(i);
+                    let tj = self.predict(j);
                     self.queue.update_two(i, ti, j, tj);
                 }
                 Kind::Wall => {
                     self.stats.walls += 1;
                     let b = &mut self.bodies[i];
-                    let mut s = b.sphere(self.mass[i]);
+                    let mut s = b.sphere(self.mass.get(i));
                     let mask = [ev.mask & 1 != 0, ev.mask & 2 != 0, ev.mask & 4 != 0];
                     for (k, &hit) in mask.iter().enumerate() {
                         if hit && s.vel[k] != 0.0 {
@@ -484,8 +486,8 @@ impl<Q: EventQueue> EventDriven<Q> {
     }
 
     fn collide(&mut self, i: usize, j: usize, c: &mut Counters) {
-        let mut a = self.bodies[i].sphere(self.mass[i]);
-        let mut b = self.bodies[j].sphere(self.mass[j]);
+        let mut a = self.bodies[i].sphere(self.mass.get(i));
+        let mut b = self.bodies[j].sphere(self.mass.get(j));
         let before = [a.vel, b.vel];
         if resolve_pair(&mut a, &mut b) {
             c.sphere_collisions += 1;
@@ -515,8 +517,8 @@ impl<Q: EventQueue> EventDriven<Q> {
 
     /// After a capped step: finish it by free flight with wall bounces.
     fn fly_all(&mut self, target: f64, c: &mut Counters) {
-        for (b, &m) in self.bodies.iter_mut().zip(&self.mass) {
-            let mut s = b.sphere(m);
+        for (i, b) in self.bodies.iter_mut().enumerate() {
+            let mut s = b.sphere(self.mass.get(i));
             let (imp, hits) = fly(&mut s, self.size, target - b.t);
             c.wall_momentum += imp;
             c.wall_collisions += hits;

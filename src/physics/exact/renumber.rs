@@ -116,18 +116,14 @@ impl<Q: EventQueue> EventDriven<Q> {
             .map(|&old| self.queue.time_of(old as usize))
             .collect();
         apply(&mut self.bodies, &perm);
-        apply(&mut self.mass, &perm);
+        self.mass.relabel(&perm);
         apply(&mut self.order, &perm);
         apply(&mut self.counts, &perm);
-        apply(&mut self.events, &perm);
-        for ev in &mut self.events {
-            relabel(ev, &inv);
-        }
-        if !self.pending.is_empty() {
-            apply(&mut self.pending, &perm);
-            for (_, ev) in &mut self.pending {
-                relabel(ev, &inv);
-            }
+        apply(&mut self.slots, &perm);
+        for slot in &mut self.slots {
+            let mut ev = slot.ev;
+            relabel(&mut ev, &inv);
+            slot.ev = ev;
         }
         match &mut self.broad {
             Broad::Lists(nl) => nl.relabel(&perm, &inv),

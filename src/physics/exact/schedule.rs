@@ -28,8 +28,60 @@ pub enum Kind {
 pub struct Event {
     pub kind: Kind,
     pub mask: u8,
+    /// In a [`Slot`] in cell mode: 0 when the queue holds this event,
+    /// else the broad-phase event it holds (it came first): `8 | mask` of a
+    /// crossing, or 24 for a large sphere's rescan. It fills what was padding.
+    pub cross: u8,
     pub partner: u32,
     pub partner_count: u32,
+}
+
+/// What the loop keeps of a sphere's prediction, 20 bytes: its best event
+/// other than a crossing and that event's absolute time (cell mode; lists
+/// keep the time in the queue alone), and whether the next crossing comes
+/// first. A crossing is cheap to tell from the grid, so only its direction
+/// is kept.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, packed(4))]
+pub struct Slot {
+    pub t: f64,
+    pub ev: Event,
+}
+
+impl Default for Slot {
+    fn default() -> Self {
+        Slot {
+            t: f64::INFINITY,
+            ev: Event::default(),
+        }
+    }
+}
+
+impl Slot {
+    /// The event the queue holds for this sphere.
+    #[inline]
+    pub fn queued(self) -> Event {
+        let ev = self.ev;
+        let crossing = Event {
+            kind: [Kind::Cross, Kind::Relist][usize::from(ev.cross & 16 != 0)],
+            mask: ev.cross & 7,
+            ..Event::default()
+        };
+        // By index: which of the two it is is random (see `with_crossing`).
+        [ev, crossing][usize::from(ev.cross != 0)]
+    }
+
+    /// The pending event itself (not the crossing).
+    #[inline]
+    pub fn pending(self) -> (f64, Event) {
+        (
+            self.t,
+            Event {
+                cross: 0,
+                ..self.ev
+            },
+        )
+    }
 }
 
 /// The running earliest event of sphere `a` (already moved to `now = a.t`).
@@ -129,9 +181,9 @@ impl<'a> Predictor<'a> {
             self.bound = t;
             self.ev = Event {
                 kind: Kind::Pair,
-                mask: 0,
                 partner: j,
                 partner_count: self.counts[j as usize],
+                ..Event::default()
             };
         }
     }

@@ -1,13 +1,16 @@
 //! The spheres of each cell, for the cell-crossing broad phase, laid out for
-//! gathering a stencil of cells fast: each cell has a small block holding
+//! gathering a stencil of cells fast: each cell names a small block holding
 //! its count and its first [`BLOCK`] spheres, so collecting a cell is one
 //! fixed-size copy. Walking a linked list instead ends each cell with a
 //! data-dependent branch (how many spheres?) that mispredicts about once per
-//! cell, which measured as the largest cost of a prediction. The rare
-//! spheres beyond [`BLOCK`] in one cell wait in a map from the cell, so a
-//! cell costs its 16-byte block and nothing more.
-use crate::physics::exact::NONE;
-use crate::physics::exact::renumber::apply;
+//! cell, which measured as the largest cost of a prediction. Most cells are
+//! empty (up to 4 a sphere) and most of the others hold one sphere, so a
+//! cell is one word: empty, its lone sphere, or the index of its block in
+//! a pool with a free list. A cell costs 4 bytes, one of two spheres or
+//! more 16 more, and the gather stays without a branch (a lone sphere is
+//! written and counted by its flag, then a block is copied: the shared
+//! empty one unless the cell has its own). The rare spheres beyond
+//! [`BLOCK`] in one cell wait in a map from the cell.
 use std::collections::HashMap;
 
 /// Spheres a cell's block holds (cells are about a diameter wide, so most
@@ -17,56 +20,91 @@ pub const BLOCK: usize = 3;
 const WORDS: usize = BLOCK + 1;
 /// Length of the scratch window the stencils are gathered into.
 const SCRATCH: usize = WINDOW + WORDS;
+/// The slot of an empty cell, and the block every cell without one of its
+/// own copies (never written).
+const EMPTY: u32 = 0;
+/// Flag of a slot holding a lone sphere (the rest of the word).
+const ONE: u32 = 1 << 31;
+/// End of the free list.
+const NO_BLOCK: u32 = u32::MAX;
 
 #[derive(Clone, Debug, Default)]
 pub struct CellBlocks {
-    /// Per cell: the first `BLOCK` spheres, then the count.
-    blocks: Vec<[u32; WORDS]>,
+    /// Per cell: [`EMPTY`], `ONE | sphere` when it holds one, or its block
+    /// in `pool` when it holds more.
+    slot: Vec<u32>,
+    /// The blocks: the first `BLOCK` spheres, then the count. A free block
+    /// links the next free one in its first word.
+    pool: Vec<[u32; WORDS]>,
+    free: u32,
     /// Spheres `BLOCK..count` of the cells holding more than `BLOCK`.
     overflow: HashMap<u32, Vec<u32>>,
-    /// Each sphere's cell (`NONE` for one in no cell) and place in it.
-    at: Vec<(u32, u32)>,
 }
 
 impl CellBlocks {
-    /// `spheres` spheres, none in a cell, and `cells` empty cells.
+    /// `cells` empty cells, with room for blocks for as many cells as
+    /// `spheres` can fill two at a time (reserved, not touched: the pool
+    /// never needs more, so it never moves).
     pub fn reset(&mut self, spheres: usize, cells: usize) {
-        self.at.clear();
-        self.at.resize(spheres, (NONE, NONE));
-        self.blocks.clear();
-        self.blocks.resize(cells, [0; WORDS]);
+        self.slot = vec![EMPTY; cells];
+        self.pool = Vec::with_capacity((spheres / 2).min(cells) + 1);
+        self.pool.push([0; WORDS]);
+        self.free = NO_BLOCK;
         self.overflow.clear();
     }
 
-    /// Bytes held on the heap.
+    /// Bytes held on the heap (the pool's untouched reserve not counted).
     pub fn heap_bytes(&self) -> usize {
         let over: usize = self.overflow.values().map(|v| v.capacity() * 4 + 32).sum();
-        self.blocks.capacity() * size_of::<[u32; WORDS]>()
-            + self.at.capacity() * size_of::<(u32, u32)>()
+        self.slot.capacity() * 4
+            + self.pool.len() * size_of::<[u32; WORDS]>()
             + self.overflow.capacity() * (size_of::<(u32, Vec<u32>)>() + 1)
             + over
     }
 
     /// Cells, padding included.
     pub fn cells(&self) -> usize {
-        self.blocks.len()
+        self.slot.len()
+    }
+
+    /// A slot read for a gather: its lone sphere (meaningful when the flag
+    /// is 1), that flag, and its block (the empty one but for a cell of
+    /// two spheres or more).
+    #[inline(always)]
+    fn parts(&self, s: u32) -> (u32, usize, &[u32; WORDS]) {
+        let one = s >> 31;
+        let block = s & one.wrapping_sub(1);
+        (s & !ONE, one as usize, &self.pool[block as usize])
+    }
+
+    /// Cell `c`'s block (it has one: it holds two spheres or more).
+    #[inline]
+    fn block(&self, c: usize) -> &[u32; WORDS] {
+        &self.pool[self.slot[c] as usize]
+    }
+
+    #[inline]
+    fn block_mut(&mut self, c: usize) -> &mut [u32; WORDS] {
+        &mut self.pool[self.slot[c] as usize]
     }
 
     /// Spheres in cell `c`.
     #[inline]
     pub fn count(&self, c: usize) -> u32 {
-        self.blocks[c][BLOCK]
+        let (_, one, b) = self.parts(self.slot[c]);
+        one as u32 + b[BLOCK]
     }
 
+    /// Whether cell `c` holds no sphere.
     #[inline]
-    pub fn cell(&self, i: usize) -> u32 {
-        self.at[i].0
+    pub fn is_empty(&self, c: usize) -> bool {
+        self.slot[c] == EMPTY
     }
 
     #[inline]
     fn set(&mut self, c: usize, k: usize, j: u32) {
         if k < BLOCK {
-            self.blocks[c][k] = j;
+            self.block_mut(c)[k] = j;
         } else {
             let o = self.overflow.entry(c as u32).or_default();
             if k - BLOCK == o.len() {
@@ -75,31 +113,74 @@ impl CellBlocks {
                 o[k - BLOCK] = j;
             }
         }
-        self.at[j as usize] = (c as u32, k as u32);
     }
 
     #[inline]
     fn get(&self, c: usize, k: usize) -> u32 {
         if k < BLOCK {
-            self.blocks[c][k]
+            self.block(c)[k]
         } else {
             self.overflow[&(c as u32)][k - BLOCK]
         }
     }
 
+    /// Put sphere `i` last in cell `c`.
     #[inline]
     pub fn insert(&mut self, i: usize, c: usize) {
-        let k = self.blocks[c][BLOCK] as usize;
-        self.set(c, k, i as u32);
-        self.blocks[c][BLOCK] += 1;
+        let s = self.slot[c];
+        if s == EMPTY {
+            self.slot[c] = ONE | i as u32;
+        } else if s & ONE != 0 {
+            let b = if self.free == NO_BLOCK {
+                self.pool.push([0; WORDS]);
+                self.pool.len() - 1
+            } else {
+                let b = self.free as usize;
+                self.free = self.pool[b][0];
+                b
+            };
+            let mut block = [0; WORDS];
+            (block[0], block[1], block[BLOCK]) = (s & !ONE, i as u32, 2);
+            self.pool[b] = block;
+            self.slot[c] = b as u32;
+        } else {
+            let k = self.block(c)[BLOCK] as usize;
+            self.set(c, k, i as u32);
+            self.block_mut(c)[BLOCK] += 1;
+        }
     }
 
-    /// Take sphere `i` out of its cell; the cell's last sphere fills its place.
+    /// Sphere `i`'s place in cell `c`, a cell with a block (it holds a few;
+    /// the rare crowded one is searched past its block).
     #[inline]
-    pub fn remove(&mut self, i: usize) {
-        let (c, k) = self.at[i];
-        let (c, k) = (c as usize, k as usize);
-        let last = self.blocks[c][BLOCK] as usize - 1;
+    fn place(&self, i: usize, c: usize) -> usize {
+        let b = self.block(c);
+        let i = i as u32;
+        let inline = (b[BLOCK] as usize).min(BLOCK);
+        if let Some(k) = b[..inline].iter().position(|&j| j == i) {
+            return k;
+        }
+        let more = self
+            .overflow
+            .get(&(c as u32))
+            .map_or(&[][..], Vec::as_slice);
+        let k = more.iter().position(|&j| j == i);
+        debug_assert!(k.is_some(), "sphere {i} is not in cell {c}");
+        BLOCK + k.unwrap_or(0)
+    }
+
+    /// Take sphere `i` out of cell `c`, its cell; the cell's last sphere
+    /// fills its place (so every cell keeps the order it had).
+    #[inline]
+    pub fn remove(&mut self, i: usize, c: usize) {
+        let s = self.slot[c];
+        if s & ONE != 0 {
+            debug_assert_eq!(s & !ONE, i as u32, "cell {c}");
+            self.slot[c] = EMPTY;
+            return;
+        }
+        let k = self.place(i, c);
+        let last = self.block(c)[BLOCK] as usize - 1;
         if k != last {
             let moved = self.get(c, last);
             self.set(c, k, moved);
@@ -111,31 +192,47 @@ impl CellBlocks {
         {
             o.pop();
         }
-        self.blocks[c][BLOCK] -= 1;
-        self.at[i] = (NONE, NONE);
+        self.block_mut(c)[BLOCK] -= 1;
+        if last == 1 {
+            // One sphere left, first in the block: the cell holds it alone.
+            let b = s as usize;
+            let lone = self.pool[b][0];
+            self.pool[b][0] = self.free;
+            self.free = b as u32;
+            self.slot[c] = ONE | lone;
+        }
     }
 
-    /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
-    /// every cell keeps its order.
-    pub fn relabel(&mut self, perm: &[u32], inv: &[u32]) {
-        for (old, &(c, k)) in self.at.iter().enumerate() {
-            if c == NONE {
+    /// The spheres are relabelled (`inv[old] = new`); every cell keeps its
+    /// order.
+    pub fn relabel(&mut self, inv: &[u32]) {
+        for c in 0..self.slot.len() {
+            let s = self.slot[c];
+            if s & ONE != 0 {
+                self.slot[c] = ONE | inv[(s & !ONE) as usize];
                 continue;
             }
-            let (k, new) = (k as usize, inv[old]);
-            if k < BLOCK {
-                self.blocks[c as usize][k] = new;
-            } else if let Some(o) = self.overflow.get_mut(&c) {
-                o[k - BLOCK] = new;
+            if s == EMPTY {
+                continue;
+            }
+            let b = self.block_mut(c);
+            let inline = (b[BLOCK] as usize).min(BLOCK);
+            for j in &mut b[..inline] {
+                *j = inv[*j as usize];
             }
         }
-        apply(&mut self.at, perm);
+        for o in self.overflow.values_mut() {
+            for j in o {
+                *j = inv[*j as usize];
+            }
+        }
     }
 
+    /// Move sphere `i` from cell `from` to the end of cell `to`.
     #[inline]
-    pub fn move_to(&mut self, i: usize, c: usize) {
-        self.remove(i);
-        self.insert(i, c);
+    pub fn move_to(&mut self, i: usize, from: usize, to: usize) {
+        self.remove(i, from);
+        self.insert(i, to);
     }
 
     /// Collect the spheres of the cells `base + offsets[..]` into `out[..n]`
@@ -164,7 +261,9 @@ impl CellBlocks {
         };
         if let Some(window) = window {
             for &o in offsets {
-                let b = &self.blocks[base + o];
+                let (lone, one, b) = self.parts(self.slot[base + o]);
+                window[n & (WINDOW - 1)] = lone;
+                n += one;
                 let at = n & (WINDOW - 1);
                 window[at..at + WORDS].copy_from_slice(b);
                 counts |= b[BLOCK];
@@ -172,7 +271,9 @@ impl CellBlocks {
             }
         } else {
             for &o in offsets {
-                let b = &self.blocks[base + o];
+                let (lone, one, b) = self.parts(self.slot[base + o]);
+                out[n] = lone;
+                n += one;
                 out[n..n + WORDS].copy_from_slice(b);
                 counts |= b[BLOCK];
                 n += (b[BLOCK] as usize).min(BLOCK);
@@ -212,13 +313,15 @@ impl CellBlocks {
         };
         // One bounds check per cell remains, never taken (a cell in the
         // grid has its stencil in the grid, padding included).
-        let blocks = &self.blocks[base..];
+        let slot = &self.slot[base..];
         let mut n = 0;
         let mut counts = 0;
         for &o in offsets {
-            let b = &blocks[o];
+            let (lone, one, b) = self.parts(slot[o]);
             // Each count is at most BLOCK on this path, so `n` stays within
             // the window; the mask only lets the compiler see that.
+            window[n & (WINDOW - 1)] = lone;
+            n += one;
             let at = n & (WINDOW - 1);
             window[at..at + WORDS].copy_from_slice(b);
             counts |= b[BLOCK];
@@ -249,34 +352,49 @@ mod tests {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
         let mut s = CellBlocks::default();
         s.reset(spheres, cells);
+        assert_eq!(s.pool.capacity(), cells + 1);
+        s.reset(3, cells);
+        assert_eq!(s.pool.capacity(), 2);
+        s.reset(spheres, cells);
         let mut reference: Vec<Vec<u32>> = vec![Vec::new(); cells];
         let mut out = Vec::new();
+        let mut most_blocks = 0;
         for step in 0..20_000 {
             let i = rng.random_range(0..spheres);
             let to = rng.random_range(0..cells);
             let here = reference.iter().position(|l| l.contains(&(i as u32)));
-            match (here, rng.random_range(0..4)) {
-                (None, _) => s.insert(i, to),
-                (Some(_), 0) => s.remove(i),
-                (Some(_), _) => s.move_to(i, to),
-            }
+            let removed = match (here, rng.random_range(0..4)) {
+                (None, _) => {
+                    s.insert(i, to);
+                    false
+                }
+                (Some(c), 0) => {
+                    s.remove(i, c);
+                    true
+                }
+                (Some(c), _) => {
+                    s.move_to(i, c, to);
+                    false
+                }
+            };
             if let Some(c) = here {
-                reference[c].retain(|&j| j != i as u32);
+                // The last fills the place, as the blocks do: order is kept.
+                let l = &mut reference[c];
+                let k = l.iter().position(|&j| j == i as u32).unwrap();
+                l.swap_remove(k);
             }
-            if here.is_none() || s.cell(i) != NONE {
+            if !removed {
                 reference[to].push(i as u32);
             }
             for (c, want) in reference.iter().enumerate() {
                 let n = s.gather(c, &[0], &mut out);
-                let mut got = out[..n].to_vec();
-                got.sort_unstable();
-                let mut want = want.clone();
-                want.sort_unstable();
-                assert_eq!(got, want, "cell {c} after step {step}");
-                for &j in &want {
-                    assert_eq!(s.cell(j as usize), c as u32);
-                }
+                assert_eq!(out[..n], want[..], "cell {c} after step {step}");
+                assert_eq!(s.count(c) as usize, want.len());
             }
+            // One block a cell of two spheres or more, and the empty one.
+            let occupied = reference.iter().filter(|l| l.len() > 1).count();
+            most_blocks = most_blocks.max(occupied);
+            assert_eq!(s.pool.len(), most_blocks + 1, "step {step}");
             let all = s.gather(0, &(0..cells).collect::<Vec<_>>(), &mut out);
             assert_eq!(all, reference.iter().map(Vec::len).sum::<usize>());
             // More cells than the fast path's window holds (a large sphere's scan).
@@ -301,17 +419,20 @@ mod tests {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
         let mut s = CellBlocks::default();
         s.reset(spheres, cells);
-        for i in 0..spheres {
+        let mut at = vec![0; spheres];
+        for (i, a) in at.iter_mut().enumerate() {
             // Crowd the low cells, so some hold more than BLOCK.
             let crowd = rng.random_range(1..=cells);
-            let c = rng.random_range(0..crowd);
-            s.insert(i, c);
+            *a = rng.random_range(0..crowd);
+            s.insert(i, *a);
         }
         let (mut a, mut b) = (Vec::new(), Vec::new());
         let mut overflowed = 0;
         for _ in 0..2000 {
             let i = rng.random_range(0..spheres);
-            s.move_to(i, rng.random_range(0..cells));
+            let to = rng.random_range(0..cells);
+            s.move_to(i, at[i], to);
+            at[i] = to;
             let base = rng.random_range(0..cells - 30);
             let o27: [usize; 27] = std::array::from_fn(|_| rng.random_range(0..30));
             let o9: [usize; 9] = std::array::from_fn(|_| rng.random_range(0..30));
@@ -321,9 +442,7 @@ mod tests {
             let n = s.gather(base, &o9, &mut a);
             assert_eq!(s.gather_stencil(base, &o9, &mut b), n);
             assert_eq!(a[..n], b[..n]);
-            overflowed +=
-                o27.iter()
-                    .any(|&o| s.blocks[base + o][BLOCK] as usize > BLOCK) as u32;
+            overflowed += o27.iter().any(|&o| s.count(base + o) as usize > BLOCK) as u32;
         }
         assert!(overflowed > 100, "only {overflowed} gathers overflowed");
     }

@@ -13,7 +13,6 @@
 //! checks the large ones).
 pub mod blocks;
 
-use super::NONE;
 use super::body::Body;
 use super::large::{BIG_FACTOR, split_big, time_to_leave};
 use super::renumber::apply;
@@ -28,6 +27,26 @@ use glam::DVec3;
 /// spheres at packing 0.005 and 0.1: 2 was as fast when dilute but slower at
 /// 0.1, where cells a diameter wide are about 5 a sphere.
 pub const CELLS_PER_SPHERE: u32 = 4;
+
+/// Bits of one axis in a sphere's packed cell coordinates.
+const AXIS_BITS: u32 = 10;
+const AXIS_MASK: u32 = (1 << AXIS_BITS) - 1;
+/// A large sphere's place: in no cell.
+const BIG: u32 = 1 << 31;
+const _: () = assert!(512 <= AXIS_MASK && 3 * AXIS_BITS < 31);
+
+fn pack(c: [usize; 3]) -> u32 {
+    (c[0] | c[1] << AXIS_BITS | c[2] << (2 * AXIS_BITS)) as u32
+}
+
+#[inline(always)]
+fn unpack(p: u32) -> [u32; 3] {
+    [
+        p & AXIS_MASK,
+        p >> AXIS_BITS & AXIS_MASK,
+        p >> (2 * AXIS_BITS) & AXIS_MASK,
+    ]
+}
 
 #[derive(Clone, Debug, Default)]
 pub struct CellGrid {
@@ -45,16 +64,18 @@ pub struct CellGrid {
     /// in memory, so a search over cells meets each pair of cells once.
     forward: [usize; 13],
     layers: [[usize; 9]; 8],
-    /// Each small sphere's cell coordinates (unpadded), kept so that events
-    /// need no integer division; `u16` as a side has at most 512 cells.
-    coord: Vec<[u16; 3]>,
+    /// Each sphere's cell coordinates (unpadded), [`AXIS_BITS`] an axis (a
+    /// side has at most 512 cells), or [`BIG`] for a large one (in no cell):
+    /// kept so that events need no integer division, and the cell's index
+    /// is a multiply-add away.
+    place: Vec<u32>,
     cell: f64,
     /// The small spheres of each cell; large ones are in no cell.
     list: CellBlocks,
+    /// The large spheres, in increasing order (found by bisection).
     bigs: Vec<u32>,
     /// Where each large sphere last scanned from (indexed like `bigs`).
     scan_centre: Vec<DVec3>,
-    big_slot: Vec<u32>,
     small_rmax: f64,
     skin: f64,
 }
@@ -64,9 +85,9 @@ impl CellGrid {
     /// cells per sphere.
     pub fn build(&mut self, bodies: &[Body], size: f64, per_sphere: u32) {
         let n = bodies.len();
-        self.list.reset(n, 0);
-        self.big_slot.clear();
-        self.big_slot.resize(n, NONE);
+        self.list.reset(0, 0);
+        self.place.clear();
+        self.place.resize(n, BIG);
         self.bigs.clear();
         self.scan_centre.clear();
         if n == 0 {
@@ -87,16 +108,13 @@ impl CellGrid {
         self.skin = self.cell;
         self.set_stencils();
         self.list.reset(n, self.padded.pow(3));
-        self.coord.clear();
-        self.coord.resize(n, [0; 3]);
         for (i, b) in bodies.iter().enumerate() {
             if b.radius > big_above {
-                self.big_slot[i] = self.bigs.len() as u32;
                 self.bigs.push(i as u32);
                 self.scan_centre.push(b.pos);
             } else {
                 let c = self.coords(b.pos);
-                self.coord[i] = c.map(|x| x as u16);
+                self.place[i] = pack(c);
                 self.list.insert(i, self.index(c));
             }
         }
@@ -135,9 +153,8 @@ impl CellGrid {
 
     /// Bytes held on the heap.
     pub fn heap_bytes(&self) -> usize {
-        self.coord.capacity() * size_of::<[u16; 3]>()
+        (self.place.capacity() + self.bigs.capacity()) * 4
             + self.list.heap_bytes()
-            + (self.bigs.capacity() + self.big_slot.capacity()) * 4
             + self.scan_centre.capacity() * size_of::<DVec3>()
     }
 
@@ -148,7 +165,21 @@ impl CellGrid {
 
     #[inline]
     pub fn is_big(&self, i: usize) -> bool {
-        self.big_slot[i] != NONE
+        self.place[i] & BIG != 0
+    }
+
+    /// Large sphere `i`'s index in `bigs`.
+    fn big_slot(&self, i: usize) -> usize {
+        let (Ok(k) | Err(k)) = self.bigs.binary_search(&(i as u32));
+        k
+    }
+
+    /// Index of small sphere `i`'s cell.
+    #[inline]
+    fn cell_of(&self, i: usize) -> usize {
+        let [x, y, z] = unpack(self.place[i]);
+        let q = self.padded;
+        (x as usize + 1) + q * ((y as usize + 1) + q * (z as usize + 1))
     }
 
     /// The broad-phase event of sphere `i` (at `b.t`): its next cell crossing,
@@ -156,7 +187,7 @@ impl CellGrid {
     #[inline]
     pub fn next_event(&self, i: usize, b: &Body) -> (f64, Event) {
         if self.is_big(i) {
-            let d = b.pos - self.scan_centre[self.big_slot[i] as usize];
+            let d = b.pos - self.scan_centre[self.big_slot(i)];
             let t = time_to_leave(d, b.vel, self.skin * (1.0 - 1e-6));
             if t == f64::INFINITY {
                 return (f64::INFINITY, Event::default());
@@ -167,7 +198,7 @@ impl CellGrid {
             };
             return (t, ev);
         }
-        let coord = self.coord[i];
+        let coord = unpack(self.place[i]);
         let last = self.per_side as u32 - 1;
         let mut best = f64::INFINITY;
         let mut mask = 0u8;
@@ -175,7 +206,6 @@ impl CellGrid {
         // branch on them mispredicts half the time (and LLVM turns plain
         // selects back into such branches; indexing does not).
         for (k, &ck) in coord.iter().enumerate() {
-            let ck = u32::from(ck);
             let v = b.vel[k];
             let up = v > 0.0;
             let face = ck + up as u32;
@@ -201,28 +231,34 @@ impl CellGrid {
         let q = self.padded;
         let axis = (mask & 3) as usize;
         let stride = [1, q, q * q][axis];
-        let c = self.list.cell(i) as usize;
+        let c = self.cell_of(i);
         let up = mask & 4 != 0;
         let to = if up { c + stride } else { c - stride };
-        let k = &mut self.coord[i][axis];
-        *k = if up { *k + 1 } else { *k - 1 };
-        self.list.move_to(i, to);
+        let one = 1 << (AXIS_BITS * axis as u32);
+        let p = &mut self.place[i];
+        *p = if up { *p + one } else { *p - one };
+        self.list.move_to(i, c, to);
     }
 
     /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
     /// every cell keeps its order.
     pub fn relabel(&mut self, perm: &[u32], inv: &[u32]) {
-        self.list.relabel(perm, inv);
-        apply(&mut self.coord, perm);
-        apply(&mut self.big_slot, perm);
-        for b in &mut self.bigs {
-            *b = inv[*b as usize];
-        }
+        self.list.relabel(inv);
+        apply(&mut self.place, perm);
+        let mut bigs: Vec<(u32, DVec3)> = self
+            .bigs
+            .iter()
+            .zip(&self.scan_centre)
+            .map(|(&b, &c)| (inv[b as usize], c))
+            .collect();
+        bigs.sort_unstable_by_key(|b| b.0);
+        (self.bigs, self.scan_centre) = bigs.into_iter().unzip();
     }
 
     /// A large sphere rescans from where it is now.
     pub fn rescan(&mut self, i: usize, b: &Body) {
-        self.scan_centre[self.big_slot[i] as usize] = b.pos;
+        let k = self.big_slot(i);
+        self.scan_centre[k] = b.pos;
     }
 
     /// Every sphere that sphere `i` could touch before its next broad-phase
@@ -232,7 +268,7 @@ impl CellGrid {
     #[inline]
     pub fn candidates(&self, i: usize, b: &Body, out: &mut Vec<u32>) -> usize {
         let n = if self.is_big(i) {
-            let centre = self.scan_centre[self.big_slot[i] as usize];
+            let centre = self.scan_centre[self.big_slot(i)];
             let reach = DVec3::splat((b.radius + self.small_rmax + self.skin) * (1.0 + 1e-9));
             let (lo, hi) = (self.coords(centre - reach), self.coords(centre + reach));
             let cells: Vec<usize> = (lo[2]..=hi[2])
@@ -243,7 +279,7 @@ impl CellGrid {
                 .collect();
             self.list.gather(0, &cells, out)
         } else {
-            let corner = self.list.cell(i) as usize - self.stencil[0];
+            let corner = self.cell_of(i) - self.stencil[0];
             self.list.gather_stencil(corner, &self.stencil, out)
         };
         if self.bigs.is_empty() {
@@ -272,7 +308,7 @@ impl CellGrid {
     ) {
         for c in cells {
             // Most cells are empty (up to 4 a sphere); padding always is.
-            if self.list.count(c) == 0 {
+            if self.list.is_empty(c) {
                 continue;
             }
             let k = self.list.gather_stencil(c, &[0], own);
@@ -292,7 +328,7 @@ impl CellGrid {
     /// all it could touch (Rapaport's trick: a crossing scans 9 cells, not 27).
     #[inline]
     pub fn new_candidates(&self, i: usize, mask: u8, out: &mut Vec<u32>) -> usize {
-        let corner = self.list.cell(i) as usize - self.stencil[0];
+        let corner = self.cell_of(i) - self.stencil[0];
         self.list
             .gather_stencil(corner, &self.layers[mask as usize], out)
     }
