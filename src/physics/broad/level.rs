@@ -55,6 +55,9 @@ pub(super) struct Level {
     pub(super) entries: Vec<Entry>,
     /// Per lane of `fill_lanes`: where each of its entries comes from.
     orders: Vec<Mutex<Vec<u32>>>,
+    /// Per lane of `fill_lanes`, for a source without records: where each
+    /// layer's records go next, and room for one layer's records.
+    layers: Vec<Mutex<(Vec<u32>, Vec<Entry>)>>,
     /// Largest reach in this level.
     pub(super) reach_max: f64,
 }
@@ -221,6 +224,7 @@ impl Level {
     /// (made while staging), with (how many, widest reach). A source
     /// without `records` is placed through the index arrays, and its keys'
     /// reaches are not read (the caller keeps the widest).
+    #[allow(clippy::too_many_lines)] // the two passes of one sort, sharing their tables
     pub(super) fn fill_lanes<S: Source + ?Sized>(
         &mut self,
         staged: &S,
@@ -245,6 +249,13 @@ impl Level {
         let totals: Vec<Mutex<(u32, f64)>> = (0..lanes)
             .map(|_| Mutex::new(counted.unwrap_or((0, 0.0))))
             .collect();
+        // A source without records (a million spheres and more: the keyed
+        // first level) is sorted by layers of cells (see `place_layered`),
+        // which are counted here instead of the cells.
+        let layered = staged.records().is_none();
+        let layer = self.side * self.side;
+        self.layers.resize_with(lanes, Default::default);
+        let layers = &self.layers;
         exec.for_each_lane(&|l| {
             if l >= lanes || counted.is_some() {
                 return;
@@ -254,9 +265,22 @@ impl Level {
             table.fill(0);
             let mut reach_max: f64 = 0.0;
             let mut count = 0;
+            let mut guard = layers[l].lock();
+            let heads = &mut guard.0;
+            heads.clear();
+            let layers_here = if layered {
+                table.len().div_ceil(layer)
+            } else {
+                0
+            };
+            heads.resize(layers_here, 0);
             for (key, reach) in staged.keys() {
                 if key >= lo && key < hi {
-                    table[(key - lo) as usize] += 1;
+                    if layered {
+                        heads[(key - lo) as usize / layer] += 1;
+                    } else {
+                        table[(key - lo) as usize] += 1;
+                    }
                     // Not `f64::max`: its NaN handling makes a slow chain
                     // through every sphere, and reaches are never NaN here.
                     if reach > reach_max {
@@ -298,8 +322,24 @@ impl Level {
             }
             let (lo, hi) = (bounds[l] as u32, bounds[l + 1] as u32);
             let mut table = tables[l].lock();
-            running_sums(&mut table, offsets[l]);
             let mut region = regions[l].lock();
+            if layered {
+                let mut guard = layers[l].lock();
+                let (heads, scratch) = &mut *guard;
+                let keys = lo..hi;
+                place_layered(
+                    staged,
+                    keys,
+                    offsets[l],
+                    &mut table,
+                    &mut region,
+                    layer,
+                    heads,
+                    scratch,
+                );
+                return;
+            }
+            running_sums(&mut table, offsets[l]);
             if let Some(records) = records {
                 for s in records.iter().rev() {
                     if s.key >= lo && s.key < hi {
@@ -310,24 +350,14 @@ impl Level {
                 }
                 return;
             }
-            let mut order = orders[l].lock();
-            order.truncate(region.len());
-            if order.capacity() < region.len() {
-                // Exact, a sixty-fourth over: `resize` would double it.
-                let more = region.len() + region.len() / 64 - order.len();
-                order.reserve_exact(more);
-            }
-            order.resize(region.len(), 0);
-            for (i, (key, _)) in staged.keys().enumerate().rev() {
-                if key >= lo && key < hi {
-                    let slot = &mut table[(key - lo) as usize];
-                    *slot -= 1;
-                    order[(*slot - offsets[l]) as usize] = i as u32;
-                }
-            }
-            for (e, &i) in region.iter_mut().zip(order.iter()) {
-                *e = staged.entry(i as usize);
-            }
+            place_indirect(
+                staged,
+                lo..hi,
+                offsets[l],
+                &mut table,
+                &mut region,
+                &mut orders[l].lock(),
+            );
         });
         drop(tables);
         self.cell_start[cells] = sum;
@@ -473,6 +503,93 @@ impl Level {
         buf[..len].iter().for_each(|&j| f(j as usize));
     }
 }
+/// The placement of [`Level::fill_lanes`] for one lane of records past the
+/// caches: `order` gets where each of them comes from, then the records are
+/// copied over in order (reads of misses overlap; writes of them held the
+/// sort up). `keys`, `table`, `region` and `base` as in [`place_layered`];
+/// the table holds the cells' ends.
+fn place_indirect<S: Source + ?Sized>(
+    staged: &S,
+    keys: std::ops::Range<u32>,
+    base: u32,
+    table: &mut [u32],
+    region: &mut [Entry],
+    order: &mut Vec<u32>,
+) {
+    let (lo, hi) = (keys.start, keys.end);
+    order.truncate(region.len());
+    if order.capacity() < region.len() {
+        // Exact, a sixty-fourth over: `resize` would double it.
+        let more = region.len() + region.len() / 64 - order.len();
+        order.reserve_exact(more);
+    }
+    order.resize(region.len(), 0);
+    for (i, (key, _)) in staged.keys().enumerate().rev() {
+        if key >= lo && key < hi {
+            let slot = &mut table[(key - lo) as usize];
+            *slot -= 1;
+            order[(*slot - base) as usize] = i as u32;
+        }
+    }
+    for (e, &i) in region.iter_mut().zip(order.iter()) {
+        *e = staged.entry(i as usize);
+    }
+}
+
+/// The placement of [`Level::fill_lanes`] for one lane of a source without
+/// records. Past the caches, a record written (or read) anywhere in memory
+/// costs a miss, and past the TLB's reach a page walk too; so does a count
+/// in a cell table of megabytes. So the lane deals its records out in id
+/// order to their layers of cells (a z layer's worth of keys each: some
+/// tens of streams, each written in order), then counts and sorts each
+/// layer, which fits in the second-level cache, into its cells. `keys` are
+/// the lane's, `table` their cells, `region` where their records go,
+/// starting at `base` in the entries; `heads` holds each layer's count,
+/// `scratch` is room for one layer.
+#[allow(clippy::too_many_arguments)] // one lane's parts of the level
+fn place_layered<S: Source + ?Sized>(
+    staged: &S,
+    keys: std::ops::Range<u32>,
+    base: u32,
+    table: &mut [u32],
+    region: &mut [Entry],
+    layer: usize,
+    heads: &mut [u32],
+    scratch: &mut Vec<Entry>,
+) {
+    let (lo, hi) = (keys.start, keys.end);
+    // Each layer's count to where it starts in the region.
+    let mut start = 0;
+    for h in heads.iter_mut() {
+        (*h, start) = (start, start + *h);
+    }
+    for (i, (key, _)) in staged.keys().enumerate() {
+        if key >= lo && key < hi {
+            let head = &mut heads[(key - lo) as usize / layer];
+            region[*head as usize] = staged.entry(i);
+            *head += 1;
+        }
+    }
+    // Each layer now holds its records in id order, and ends where its
+    // head stopped; the counting sort of each, from its copy, keeps that
+    // order within a cell.
+    let mut from = 0;
+    for (k, (cells, &to)) in table.chunks_mut(layer).zip(heads.iter()).enumerate() {
+        let first = lo + (k * layer) as u32;
+        scratch.clear();
+        scratch.extend_from_slice(&region[from..to as usize]);
+        for e in scratch.iter() {
+            cells[(e.key - first) as usize] += 1;
+        }
+        running_sums(cells, base + from as u32);
+        for e in scratch.iter().rev() {
+            let slot = &mut cells[(e.key - first) as usize];
+            *slot -= 1;
+            region[(*slot - base) as usize] = *e;
+        }
+        from = to as usize;
+    }
+}
 #[inline(always)]
 pub(super) fn within(a: &Ball, b: &Ball) -> bool {
     let s = a.reach + b.reach;
@@ -485,6 +602,102 @@ fn scan(a: &Ball, ia: u32, entries: &[Entry], f: &mut impl FnMut(u32, u32)) {
     for e in entries {
         if within(a, &e.ball) {
             f(ia, e.id);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::exec::Serial;
+
+    /// `n` records with keys of real cells of `level`, from a fixed LCG.
+    fn records(level: &Level, n: usize) -> Vec<Entry> {
+        let mut x = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut unit = || {
+            x = x.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        (0..n as u32)
+            .map(|id| {
+                let pos = DVec3::new(unit(), unit(), unit());
+                Entry {
+                    ball: Ball { pos, reach: 0.001 },
+                    id,
+                    key: level.key_of(pos),
+                }
+            })
+            .collect()
+    }
+
+    /// Lanes run one after the other on the calling thread.
+    struct OneByOne(usize);
+
+    impl Exec for OneByOne {
+        fn lanes(&self) -> usize {
+            self.0
+        }
+        fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
+            (0..self.0).for_each(f);
+        }
+        fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {
+            a();
+            b();
+        }
+    }
+
+    /// A source without records, as the keyed first level is.
+    struct KeysOnly(Vec<Entry>);
+
+    impl Source for KeysOnly {
+        fn keys(&self) -> impl DoubleEndedIterator<Item = (u32, f64)> + ExactSizeIterator {
+            self.0.iter().map(|e| (e.key, e.ball.reach))
+        }
+        fn entry(&self, i: usize) -> Entry {
+            self.0[i]
+        }
+        fn records(&self) -> Option<&[Entry]> {
+            None
+        }
+    }
+
+    /// A source without records is sorted by layers of cells: the layout
+    /// is that of a stable sort by cell key, on one lane and on two, and
+    /// each cell's start is the number of records before it.
+    #[test]
+    fn layered_fill_is_a_stable_sort_by_key() {
+        let n = 40_000;
+        for lanes in [1, 2] {
+            let two = OneByOne(2);
+            let exec: &dyn Exec = if lanes > 1 { &two } else { &Serial };
+            let mut level = Level::default();
+            level.shape(1.0, 0.03, n, true);
+            let items = KeysOnly(records(&level, n));
+            level.fill_lanes(&items, exec, None);
+            let mut want = items.0.clone();
+            want.sort_by_key(|e| e.key);
+            let got = &level.entries[..n];
+            assert!(
+                got.iter()
+                    .zip(&want)
+                    .all(|(a, b)| a.id == b.id && a.key == b.key),
+                "{lanes} lanes: not the stable sort by key"
+            );
+            assert!(
+                got.iter()
+                    .all(|e| e.ball.pos == items.0[e.id as usize].ball.pos)
+            );
+            let mut per_cell = vec![0u32; level.cell_start.len() - 1];
+            for e in &items.0 {
+                per_cell[e.key as usize] += 1;
+            }
+            let mut before = 0;
+            for (k, (&start, &count)) in level.cell_start.iter().zip(&per_cell).enumerate() {
+                assert_eq!(start, before, "{lanes} lanes: cell {k}");
+                before += count;
+            }
+            assert_eq!(level.cell_start[level.cell_start.len() - 1], n as u32);
+            assert_eq!(level.reach_max, 0.001);
         }
     }
 }
