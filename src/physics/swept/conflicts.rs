@@ -3,48 +3,97 @@
 //! (noted by a run, or grown balls found by a grid over all of them) are
 //! compared turn by turn, and those that come within touching distance are
 //! conflicts: their clusters merge and run again.
-use super::cluster::{Coarse, Member, Turn};
+use super::cluster::{Chunk, Coarse, GROWTH_CAP, Member, Turn};
 use super::partition::{Partition, Slot};
 use super::path_ball;
 use super::rounds::RoundStats;
 use crate::physics::broad::Grid;
-use crate::physics::exec::{Exec, Serial};
+use crate::physics::exec::{Exec, Serial, for_each_block};
 use crate::physics::sphere::Sphere;
 use glam::DVec3;
+use parking_lot::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// Fewer grown balls than this are compared on one lane.
+/// Fewer changed balls than this are compared on one lane.
 const LANES_MIN_BALLS: usize = 2048;
+/// Changed balls per parallel block of the grown-ball check.
+const BALL_BLOCK: usize = 1024;
+/// The grown-ball check searches the grid a little wider than the balls
+/// need, so rounding never hides a ball; the pair test itself is exact.
+const SEARCH_SLACK: f64 = 1.0 + 1e-9;
 
 /// By slot, what the cluster's last finished run left.
 #[derive(Default)]
 pub(super) struct Finished {
-    /// The member's end of the step and path (None until its cluster ran).
-    pub out: Vec<Option<Member>>,
+    /// Where the member's record is: (chunk, index in it), `NO_RECORD`
+    /// until its cluster ran.
+    at: Vec<(u32, u32)>,
     /// Whether (and why) that run was capped.
     pub capped: Vec<Option<Coarse>>,
     /// The round that run was made in (NONE before any).
     pub ran: Vec<u32>,
-    /// Every finished member's turns (`Member::turn0` indexes here).
-    pub turns: Vec<Turn>,
+    /// The runs' outputs, each taken whole from the block that wrote it
+    /// (not copied: a record and its turns are kept once).
+    chunks: Vec<Chunk>,
+    /// Emptied chunks, kept for their memory.
+    spare: Vec<Chunk>,
 }
+
+const NO_RECORD: (u32, u32) = (u32::MAX, u32::MAX);
 
 impl Finished {
     pub fn reset(&mut self, m: usize) {
-        self.out.clear();
-        self.out.resize(m, None);
+        self.at.clear();
+        self.at.resize(m, NO_RECORD);
         self.capped.clear();
         self.capped.resize(m, None);
         self.ran.clear();
         self.ran.resize(m, super::NONE);
-        self.turns.clear();
+        for mut c in self.chunks.drain(..) {
+            c.clear();
+            self.spare.push(c);
+        }
     }
 
     /// Room for a slot added after the first round.
     pub fn push(&mut self) {
-        self.out.push(None);
+        self.at.push(NO_RECORD);
         self.capped.push(None);
         self.ran.push(super::NONE);
+    }
+
+    /// An empty chunk for a block of runs to write to.
+    pub fn spare(&mut self) -> Chunk {
+        self.spare.pop().unwrap_or_default()
+    }
+
+    /// Takes a block's chunk in; returns its number, for [`Finished::set`].
+    pub fn keep(&mut self, chunk: Chunk) -> u32 {
+        self.chunks.push(chunk);
+        (self.chunks.len() - 1) as u32
+    }
+
+    /// Slot `s` finished as member `k` of chunk `c`.
+    pub fn set(&mut self, s: usize, c: u32, k: usize) {
+        self.at[s] = (c, k as u32);
+    }
+
+    /// Slot `s`'s record and its turns, if its cluster ran.
+    pub fn record(&self, s: usize) -> Option<(&Member, &[Turn])> {
+        let (c, k) = self.at[s];
+        self.record_in(c, k as usize)
+    }
+
+    /// Member `k` of chunk `c` and its turns.
+    pub fn record_in(&self, c: u32, k: usize) -> Option<(&Member, &[Turn])> {
+        let chunk = self.chunks.get(c as usize)?;
+        let m = chunk.members.get(k)?;
+        Some((m, chunk.path(m)))
+    }
+
+    /// Whether slot `s`'s ball grew past the one the grid holds for it.
+    pub fn grew(&self, s: usize) -> bool {
+        self.record(s).is_some_and(|(m, _)| m.grew)
     }
 
     /// Whether the spheres of slots `a` and `b` come within touching
@@ -52,8 +101,7 @@ impl Finished {
     /// or one not run) meets everyone: a merge costs time, never a result.
     fn meet(&self, a: usize, b: usize, spheres: &[Sphere], dt: f64) -> bool {
         let path = |s: usize| {
-            let m = self.out[s].filter(|_| self.capped[s].is_none())?;
-            let turns = &self.turns[m.turn0 as usize..(m.turn0 + m.turns) as usize];
+            let (m, turns) = self.record(s).filter(|_| self.capped[s].is_none())?;
             Some((&spheres[m.id as usize], turns))
         };
         let (Some((sa, ta)), Some((sb, tb))) = (path(a), path(b)) else {
@@ -63,11 +111,12 @@ impl Finished {
     }
 
     /// The ball slot `s` (sphere `id`) stays in: from its last finished
-    /// run, or its straight path.
+    /// run (around the same centre), or its straight path.
     fn ball(&self, s: usize, id: u32, spheres: &[Sphere], dt: f64) -> (DVec3, f64) {
-        match &self.out[s] {
-            Some(m) => (m.centre, m.reach),
-            None => path_ball(&spheres[id as usize], dt),
+        let straight = path_ball(&spheres[id as usize], dt);
+        match self.record(s) {
+            Some((m, _)) => (straight.0, m.reach),
+            None => straight,
         }
     }
 }
@@ -80,12 +129,13 @@ pub(super) struct Conflicts {
     /// (sphere, sphere of another cluster) whose balls met in a standing
     /// run: their paths are compared once the runs agree.
     pub cross: Vec<(u32, u32)>,
-    /// Scratch of the grown-ball check: every slot's ball, a grid over
-    /// them, the pairs it found, each slot's cluster.
-    balls: Vec<Sphere>,
-    overlap: Grid,
-    overlap_pairs: Vec<(u32, u32)>,
+    /// Scratch of the grown-ball check: each slot's cluster, the changed
+    /// slots (and whether grown past the grid's reach), those grown past
+    /// it, the conflicts each block of them found.
     cluster_of: Vec<Slot>,
+    changed: Vec<(u32, bool)>,
+    big: Vec<u32>,
+    block_found: Vec<Mutex<Vec<(u32, u32)>>>,
 }
 
 impl Conflicts {
@@ -119,6 +169,13 @@ impl Conflicts {
     /// grown balls, or any ball and that of a bystander that joined a run (which
     /// other runs took to fly straight), may meet where no run could see
     /// it: such pairs in different clusters are compared by their paths.
+    ///
+    /// The pairs come from the step's grid, searched around each changed
+    /// ball: an unchanged ball is the one the grid holds, and a changed one
+    /// grown no further than a run's cap is found as a run finds it. Only
+    /// pairs of balls both grown past their caps are checked by hand (they
+    /// are few). No grid over the balls is built: its memory was the
+    /// largest item of the rounds.
     #[allow(clippy::too_many_arguments)]
     pub fn check_grown(
         &mut self,
@@ -126,60 +183,103 @@ impl Conflicts {
         part: &mut Partition,
         fin: &Finished,
         spheres: &[Sphere],
-        size: f64,
+        grid: &Grid,
         dt: f64,
         stats: &mut RoundStats,
     ) {
         let m = part.ids.len();
-        let any_changed = m > part.first_late || fin.out.iter().any(|o| o.is_some_and(|o| o.grew));
-        if !any_changed || m < 2 {
+        let first_late = part.first_late;
+        let changed = |s: usize| s >= first_late || fin.grew(s);
+        if m < 2 || !(m > first_late || (0..m).any(|s| fin.grew(s))) {
             return;
-        }
-        // Every slot's ball, indexed by slot.
-        self.balls.clear();
-        for s in 0..m {
-            let (centre, reach) = fin.ball(s, part.ids[s], spheres, dt);
-            self.balls.push(Sphere {
-                pos: centre,
-                vel: DVec3::ZERO,
-                radius: reach,
-                mass: 0.0,
-            });
         }
         // Merges since the round began joined clusters: name them afresh.
         self.cluster_of.clear();
         self.cluster_of
             .extend((0..m).map(|s| part.find(Slot::at(s))));
-        self.overlap.build(
-            &self.balls,
-            size,
-            |b| (b.pos, b.radius),
-            small(exec, self.balls.len()),
-        );
-        let mut pairs = std::mem::take(&mut self.overlap_pairs);
-        let cluster_of = &self.cluster_of;
-        let compared = AtomicUsize::new(0);
-        let first_late = part.first_late;
-        let changed = |s: usize| s >= first_late || fin.out[s].is_some_and(|o| o.grew);
-        // The paths are compared in the pair search, on its lanes.
-        let meet = |a: u32, b: u32| {
-            let (sa, sb) = (a as usize, b as usize);
-            if !(changed(sa) || changed(sb)) || cluster_of[sa] == cluster_of[sb] {
-                return false;
+        // The changed slots, and whether each grew past what the grid finds.
+        self.changed.clear();
+        self.big.clear();
+        for s in (0..m).filter(|&s| changed(s)) {
+            let (id, (_, reach)) = (part.ids[s], fin.ball(s, part.ids[s], spheres, dt));
+            let reach0 = path_ball(&spheres[id as usize], dt).1;
+            let big = reach > GROWTH_CAP * grid.widest_in_level(reach0);
+            self.changed.push((s as u32, big));
+            if big {
+                self.big.push(s as u32);
             }
-            compared.fetch_add(1, Ordering::Relaxed);
-            fin.meet(sa, sb, spheres, dt)
-        };
-        self.overlap
-            .pairs(small(exec, self.balls.len()), &meet, &mut pairs);
-        let compared = compared.into_inner();
-        stats.compared += compared;
-        stats.apart += compared - pairs.len();
-        for &(a, b) in &pairs {
-            self.found
-                .push((part.ids[a as usize], part.ids[b as usize]));
         }
-        self.overlap_pairs = pairs;
+        let (ids, slot, cluster_of) = (&part.ids, &part.slot, &self.cluster_of);
+        let compared = AtomicUsize::new(0);
+        let blocks = self.changed.len().div_ceil(BALL_BLOCK);
+        while self.block_found.len() < blocks {
+            self.block_found.push(Mutex::new(Vec::new()));
+        }
+        let (changed_list, block_found, bigs) = (&self.changed, &self.block_found, &self.big);
+        // In slot order, so searched; almost always empty.
+        let big = |s: usize| bigs.binary_search(&(s as u32)).is_ok();
+        let ball = |s: usize| fin.ball(s, ids[s], spheres, dt);
+        // Pair (a, b) of slots in different clusters whose balls meet:
+        // compared by their paths, noted if they meet.
+        let judge = |a: usize, b: usize, found: &mut Vec<(u32, u32)>, n: &mut usize| {
+            if cluster_of[a] == cluster_of[b] {
+                return;
+            }
+            let ((pa, ra), (pb, rb)) = (ball(a), ball(b));
+            // The test the grid's pair search makes, to the bit.
+            let r = ra + rb;
+            if (pa - pb).length_squared() > r * r {
+                return;
+            }
+            *n += 1;
+            if fin.meet(a, b, spheres, dt) {
+                found.push((ids[a], ids[b]));
+            }
+        };
+        for_each_block(small(exec, self.changed.len()), blocks, &|k| {
+            let mut found = block_found[k].lock();
+            found.clear();
+            let mut n = 0;
+            let end = ((k + 1) * BALL_BLOCK).min(changed_list.len());
+            for &(a, a_big) in &changed_list[k * BALL_BLOCK..end] {
+                let a = a as usize;
+                let (pa, ra) = ball(a);
+                // Each pair once: an unchanged `b` only from here; two
+                // changed ones from the lower, or from the grown one.
+                grid.near(
+                    pa,
+                    ra * SEARCH_SLACK,
+                    GROWTH_CAP * SEARCH_SLACK,
+                    &mut |j, _, _| {
+                        let b = slot[j as usize];
+                        if b.is_none() || b.index() == a {
+                            return;
+                        }
+                        let b = b.index();
+                        if changed(b) && (big(b) || !(a_big || a < b)) {
+                            return;
+                        }
+                        judge(a, b, &mut found, &mut n);
+                    },
+                );
+            }
+            compared.fetch_add(n, Ordering::Relaxed);
+        });
+        let mut n = 0;
+        let mut found = Vec::new();
+        for (k, &a) in self.big.iter().enumerate() {
+            for &b in &self.big[k + 1..] {
+                judge(a as usize, b as usize, &mut found, &mut n);
+            }
+        }
+        let compared = compared.into_inner() + n;
+        let before = self.found.len();
+        for f in &self.block_found[..blocks] {
+            self.found.extend_from_slice(&f.lock());
+        }
+        self.found.extend_from_slice(&found);
+        stats.compared += compared;
+        stats.apart += compared - (self.found.len() - before);
     }
 }
 
