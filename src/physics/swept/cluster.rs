@@ -127,12 +127,23 @@ impl Ord for Event {
 }
 
 /// A turn in a member's path: from time `t` of the step it is at
-/// `pos + vel (t' - t)`, until its next turn.
+/// `pos + vel (t' - t)`, until its next turn. Its position there is not
+/// kept: contacts change velocities only, so it is the last turn's (or the
+/// start's) position plus that velocity times the time since, to the bit
+/// (see [`Turn::after`]).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Turn {
     pub t: f64,
-    pub pos: DVec3,
     pub vel: DVec3,
+}
+
+impl Turn {
+    /// Where a sphere at `pos` at `t0`, flying at `vel`, is at this turn:
+    /// the same sum a run's lazy clock makes.
+    #[inline]
+    pub fn after(&self, pos: DVec3, vel: DVec3, t0: f64) -> DVec3 {
+        pos + vel * (self.t - t0)
+    }
 }
 
 /// One member's result of a finished run: only what the rounds read (its
@@ -308,14 +319,7 @@ impl Run {
     /// Member `l` changed velocity at `t` (it is there now).
     fn turn(&mut self, l: usize, t: f64) {
         let s = &self.sp[l];
-        self.turn_log.push((
-            l as u32,
-            Turn {
-                t,
-                pos: s.pos,
-                vel: s.vel,
-            },
-        ));
+        self.turn_log.push((l as u32, Turn { t, vel: s.vel }));
     }
 
     /// Writes the members of the last finished run, each with its turns

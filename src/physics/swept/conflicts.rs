@@ -16,6 +16,11 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Fewer changed balls than this are compared on one lane.
 const LANES_MIN_BALLS: usize = 2048;
+/// Below this many spheres with events, the grown-ball check builds a grid
+/// over their balls (a sphere, a grid record and cells: about 170 bytes a
+/// slot, 11 MB at this count); from it on, it searches the step's grid
+/// (8 bytes a changed slot, about three times the check's instructions).
+const OWN_GRID_MAX: usize = 1 << 16;
 /// Changed balls per parallel block of the grown-ball check.
 const BALL_BLOCK: usize = 1024;
 /// The grown-ball check searches the grid a little wider than the balls
@@ -32,11 +37,12 @@ pub(super) struct Finished {
     pub capped: Vec<Option<Coarse>>,
     /// The round that run was made in (NONE before any).
     pub ran: Vec<u32>,
+    /// Whether the member's ball grew past the one the grid holds for it.
+    grew: Vec<bool>,
     /// The runs' outputs, each taken whole from the block that wrote it
-    /// (not copied: a record and its turns are kept once).
+    /// (not copied: a record and its turns are kept once). Not pooled for
+    /// reuse: chunks of any size would each keep the largest they ever held.
     chunks: Vec<Chunk>,
-    /// Emptied chunks, kept for their memory.
-    spare: Vec<Chunk>,
 }
 
 const NO_RECORD: (u32, u32) = (u32::MAX, u32::MAX);
@@ -49,10 +55,17 @@ impl Finished {
         self.capped.resize(m, None);
         self.ran.clear();
         self.ran.resize(m, super::NONE);
-        for mut c in self.chunks.drain(..) {
-            c.clear();
-            self.spare.push(c);
-        }
+        self.grew.clear();
+        self.grew.resize(m, false);
+        self.chunks.clear();
+    }
+
+    /// Drops every record: all the slots are about to run again as one
+    /// cluster, so none is read again, and its memory is free for theirs.
+    pub fn forget(&mut self) {
+        self.at.fill(NO_RECORD);
+        self.grew.fill(false);
+        self.chunks.clear();
     }
 
     /// Room for a slot added after the first round.
@@ -60,15 +73,14 @@ impl Finished {
         self.at.push(NO_RECORD);
         self.capped.push(None);
         self.ran.push(super::NONE);
+        self.grew.push(false);
     }
 
-    /// An empty chunk for a block of runs to write to.
-    pub fn spare(&mut self) -> Chunk {
-        self.spare.pop().unwrap_or_default()
-    }
-
-    /// Takes a block's chunk in; returns its number, for [`Finished::set`].
-    pub fn keep(&mut self, chunk: Chunk) -> u32 {
+    /// Takes a block's chunk in, at its size (it grew by doubling); returns
+    /// its number, for [`Finished::set`].
+    pub fn keep(&mut self, mut chunk: Chunk) -> u32 {
+        chunk.members.shrink_to_fit();
+        chunk.turns.shrink_to_fit();
         self.chunks.push(chunk);
         (self.chunks.len() - 1) as u32
     }
@@ -76,6 +88,7 @@ impl Finished {
     /// Slot `s` finished as member `k` of chunk `c`.
     pub fn set(&mut self, s: usize, c: u32, k: usize) {
         self.at[s] = (c, k as u32);
+        self.grew[s] = self.record_in(c, k).is_some_and(|(m, _)| m.grew);
     }
 
     /// Slot `s`'s record and its turns, if its cluster ran.
@@ -93,7 +106,7 @@ impl Finished {
 
     /// Whether slot `s`'s ball grew past the one the grid holds for it.
     pub fn grew(&self, s: usize) -> bool {
-        self.record(s).is_some_and(|(m, _)| m.grew)
+        self.grew[s]
     }
 
     /// Whether the spheres of slots `a` and `b` come within touching
@@ -129,10 +142,17 @@ pub(super) struct Conflicts {
     /// (sphere, sphere of another cluster) whose balls met in a standing
     /// run: their paths are compared once the runs agree.
     pub cross: Vec<(u32, u32)>,
-    /// Scratch of the grown-ball check: each slot's cluster, the changed
-    /// slots (and whether grown past the grid's reach), those grown past
-    /// it, the conflicts each block of them found.
+    /// Scratch of the grown-ball check: each slot's cluster; with a grid of
+    /// its own, every slot's ball, that grid, the pairs it found; from the
+    /// step's grid, the changed slots (and whether grown past the grid's
+    /// reach), those grown past it, the conflicts each block of them found.
     cluster_of: Vec<Slot>,
+    /// Up to how many slots a grid of their own is built ([`OWN_GRID_MAX`]
+    /// unless a test says otherwise).
+    pub own_grid_max: Option<usize>,
+    balls: Vec<Sphere>,
+    overlap: Grid,
+    overlap_pairs: Vec<(u32, u32)>,
     changed: Vec<(u32, bool)>,
     big: Vec<u32>,
     block_found: Vec<Mutex<Vec<(u32, u32)>>>,
@@ -169,18 +189,103 @@ impl Conflicts {
     /// grown balls, or any ball and that of a bystander that joined a run (which
     /// other runs took to fly straight), may meet where no run could see
     /// it: such pairs in different clusters are compared by their paths.
-    ///
-    /// The pairs come from the step's grid, searched around each changed
-    /// ball: an unchanged ball is the one the grid holds, and a changed one
-    /// grown no further than a run's cap is found as a run finds it. Only
-    /// pairs of balls both grown past their caps are checked by hand (they
-    /// are few). No grid over the balls is built: its memory was the
-    /// largest item of the rounds.
+    /// Either way below finds the same pairs (the grid's pair test, to the
+    /// bit), in another order; the clusters they merge into do not depend
+    /// on it.
     #[allow(clippy::too_many_arguments)]
     pub fn check_grown(
         &mut self,
         exec: &dyn Exec,
         part: &mut Partition,
+        fin: &Finished,
+        spheres: &[Sphere],
+        (grid, size): (&Grid, f64),
+        dt: f64,
+        stats: &mut RoundStats,
+    ) {
+        let m = part.ids.len();
+        if m < 2 || !(m > part.first_late || (0..m).any(|s| fin.grew(s))) {
+            return;
+        }
+        // Merges since the round began joined clusters: name them afresh.
+        self.cluster_of.clear();
+        self.cluster_of
+            .extend((0..m).map(|s| part.find(Slot::at(s))));
+        if m < self.own_grid_max.unwrap_or(OWN_GRID_MAX) {
+            self.grown_by_own_grid(exec, part, fin, spheres, size, dt, stats);
+        } else {
+            self.grown_by_step_grid(exec, part, fin, spheres, grid, dt, stats);
+        }
+    }
+
+    /// [`Conflicts::check_grown`] with a grid over the slots' balls: the
+    /// pairs of any changed ball among them.
+    #[allow(clippy::too_many_arguments)]
+    fn grown_by_own_grid(
+        &mut self,
+        exec: &dyn Exec,
+        part: &Partition,
+        fin: &Finished,
+        spheres: &[Sphere],
+        size: f64,
+        dt: f64,
+        stats: &mut RoundStats,
+    ) {
+        let m = part.ids.len();
+        // Every slot's ball, indexed by slot.
+        self.balls.clear();
+        for s in 0..m {
+            let (centre, reach) = fin.ball(s, part.ids[s], spheres, dt);
+            self.balls.push(Sphere {
+                pos: centre,
+                vel: DVec3::ZERO,
+                radius: reach,
+                mass: 0.0,
+            });
+        }
+        self.overlap.build(
+            &self.balls,
+            size,
+            |b| (b.pos, b.radius),
+            small(exec, self.balls.len()),
+        );
+        let mut pairs = std::mem::take(&mut self.overlap_pairs);
+        let cluster_of = &self.cluster_of;
+        let compared = AtomicUsize::new(0);
+        let first_late = part.first_late;
+        let changed = |s: usize| s >= first_late || fin.grew(s);
+        // The paths are compared in the pair search, on its lanes.
+        let meet = |a: u32, b: u32| {
+            let (sa, sb) = (a as usize, b as usize);
+            if !(changed(sa) || changed(sb)) || cluster_of[sa] == cluster_of[sb] {
+                return false;
+            }
+            compared.fetch_add(1, Ordering::Relaxed);
+            fin.meet(sa, sb, spheres, dt)
+        };
+        self.overlap
+            .pairs(small(exec, self.balls.len()), &meet, &mut pairs);
+        let compared = compared.into_inner();
+        stats.compared += compared;
+        stats.apart += compared - pairs.len();
+        for &(a, b) in &pairs {
+            self.found
+                .push((part.ids[a as usize], part.ids[b as usize]));
+        }
+        self.overlap_pairs = pairs;
+    }
+
+    /// [`Conflicts::check_grown`] from the step's grid, searched around
+    /// each changed ball: an unchanged ball is the one the grid holds, and
+    /// a changed one grown no further than a run's cap is found as a run
+    /// finds it. Only pairs of balls both grown past their caps are checked
+    /// by hand (they are few). Eight bytes a changed slot, for about three
+    /// times the instructions of a grid over the balls.
+    #[allow(clippy::too_many_arguments)]
+    fn grown_by_step_grid(
+        &mut self,
+        exec: &dyn Exec,
+        part: &Partition,
         fin: &Finished,
         spheres: &[Sphere],
         grid: &Grid,
@@ -190,13 +295,6 @@ impl Conflicts {
         let m = part.ids.len();
         let first_late = part.first_late;
         let changed = |s: usize| s >= first_late || fin.grew(s);
-        if m < 2 || !(m > first_late || (0..m).any(|s| fin.grew(s))) {
-            return;
-        }
-        // Merges since the round began joined clusters: name them afresh.
-        self.cluster_of.clear();
-        self.cluster_of
-            .extend((0..m).map(|s| part.find(Slot::at(s))));
         // The changed slots, and whether each grew past what the grid finds.
         self.changed.clear();
         self.big.clear();
@@ -221,11 +319,13 @@ impl Conflicts {
         let ball = |s: usize| fin.ball(s, ids[s], spheres, dt);
         // Pair (a, b) of slots in different clusters whose balls meet:
         // compared by their paths, noted if they meet.
-        let judge = |a: usize, b: usize, found: &mut Vec<(u32, u32)>, n: &mut usize| {
+        let judge = |(a, pa, ra): (usize, DVec3, f64),
+                     (b, pb, rb): (usize, DVec3, f64),
+                     found: &mut Vec<(u32, u32)>,
+                     n: &mut usize| {
             if cluster_of[a] == cluster_of[b] {
                 return;
             }
-            let ((pa, ra), (pb, rb)) = (ball(a), ball(b));
             // The test the grid's pair search makes, to the bit.
             let r = ra + rb;
             if (pa - pb).length_squared() > r * r {
@@ -250,16 +350,22 @@ impl Conflicts {
                     pa,
                     ra * SEARCH_SLACK,
                     GROWTH_CAP * SEARCH_SLACK,
-                    &mut |j, _, _| {
+                    &mut |j, pj, rj| {
                         let b = slot[j as usize];
                         if b.is_none() || b.index() == a {
                             return;
                         }
                         let b = b.index();
-                        if changed(b) && (big(b) || !(a_big || a < b)) {
-                            return;
-                        }
-                        judge(a, b, &mut found, &mut n);
+                        // An unchanged ball is the grid's, to the bit.
+                        let (pb, rb) = if changed(b) {
+                            if big(b) || !(a_big || a < b) {
+                                return;
+                            }
+                            ball(b)
+                        } else {
+                            (pj, rj)
+                        };
+                        judge((a, pa, ra), (b, pb, rb), &mut found, &mut n);
                     },
                 );
             }
@@ -268,8 +374,10 @@ impl Conflicts {
         let mut n = 0;
         let mut found = Vec::new();
         for (k, &a) in self.big.iter().enumerate() {
+            let (a, (pa, ra)) = (a as usize, ball(a as usize));
             for &b in &self.big[k + 1..] {
-                judge(a as usize, b as usize, &mut found, &mut n);
+                let (b, (pb, rb)) = (b as usize, ball(b as usize));
+                judge((a, pa, ra), (b, pb, rb), &mut found, &mut n);
             }
         }
         let compared = compared.into_inner() + n;
@@ -299,11 +407,23 @@ const PATH_MARGIN: f64 = 1e-8;
 /// radii (widened by [`PATH_MARGIN`]) at one moment of `0..=dt`: on each
 /// stretch where both fly straight, the closest approach of the two lines.
 fn paths_meet(a: &Sphere, ta: &[Turn], b: &Sphere, tb: &[Turn], dt: f64) -> bool {
+    /// A stretch of a path: from time `t` at `pos`, flying at `vel`.
+    #[derive(Clone, Copy)]
+    struct Leg {
+        t: f64,
+        pos: DVec3,
+        vel: DVec3,
+    }
     let sigma = (a.radius + b.radius) * (1.0 + PATH_MARGIN);
-    let start = |s: &Sphere| Turn {
+    let start = |s: &Sphere| Leg {
         t: 0.0,
         pos: s.pos,
         vel: s.vel,
+    };
+    let turn = |l: Leg, k: &Turn| Leg {
+        t: k.t,
+        pos: k.after(l.pos, l.vel, l.t),
+        vel: k.vel,
     };
     let (mut ka, mut kb) = (start(a), start(b));
     let (mut ia, mut ib) = (0, 0);
@@ -326,11 +446,11 @@ fn paths_meet(a: &Sphere, ta: &[Turn], b: &Sphere, tb: &[Turn], dt: f64) -> bool
             return false;
         }
         while ia < ta.len() && ta[ia].t <= t1 {
-            ka = ta[ia];
+            ka = turn(ka, &ta[ia]);
             ia += 1;
         }
         while ib < tb.len() && tb[ib].t <= t1 {
-            kb = tb[ib];
+            kb = turn(kb, &tb[ib]);
             ib += 1;
         }
         t0 = t1;
@@ -350,10 +470,11 @@ mod tests {
         }
     }
 
-    fn turn(t: f64, pos: [f64; 3], vel: [f64; 3]) -> Turn {
+    /// A turn at `t` to `vel`; where the path is then follows from its
+    /// start and earlier turns.
+    fn turn(t: f64, vel: [f64; 3]) -> Turn {
         Turn {
             t,
-            pos: DVec3::from(pos),
             vel: DVec3::from(vel),
         }
     }
@@ -382,8 +503,8 @@ mod tests {
         // and straight it passes 1 away.
         let a = sphere([-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
         let b = sphere([0.0, 1.0, 0.0], [0.0, 0.0, 0.0]);
-        let up = [turn(1.0, [0.0, 0.0, 0.0], [0.0, 1.0, 0.0])];
-        let down = [turn(1.0, [0.0, 0.0, 0.0], [0.0, -1.0, 0.0])];
+        let up = [turn(1.0, [0.0, 1.0, 0.0])];
+        let down = [turn(1.0, [0.0, -1.0, 0.0])];
         assert!(!paths_meet(&a, &[], &b, &[], 3.0));
         assert!(paths_meet(&a, &up, &b, &[], 3.0));
         assert!(paths_meet(&b, &[], &a, &up, 3.0), "either order");
@@ -391,7 +512,7 @@ mod tests {
         // The meeting at t = 1.8 lies past a step of 1.5.
         assert!(!paths_meet(&a, &up, &b, &[], 1.5));
         // Both turn: `b` runs off along +y at t = 0.5 and stays ahead.
-        let away = [turn(0.5, [0.0, 1.0, 0.0], [0.0, 2.0, 0.0])];
+        let away = [turn(0.5, [0.0, 2.0, 0.0])];
         assert!(!paths_meet(&a, &up, &b, &away, 3.0));
     }
 }
