@@ -25,7 +25,7 @@ const SMALL_RUN: usize = 32;
 /// found through the grid: wider searches cost more each, a narrower cap
 /// puts more balls on the run's own `grown` list (docs/benchmarks.md, "tuned
 /// constants").
-pub(super) const GROWTH_CAP: f64 = 1.25;
+const GROWTH_CAP: f64 = 1.25;
 
 /// An event's own cost in pair checks: the queue, the grid cells its
 /// rescans visit, its turns kept and compared (measured: about 400 pair

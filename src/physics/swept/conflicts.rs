@@ -3,29 +3,18 @@
 //! (noted by a run, or grown balls found by a grid over all of them) are
 //! compared turn by turn, and those that come within touching distance are
 //! conflicts: their clusters merge and run again.
-use super::cluster::{Chunk, Coarse, GROWTH_CAP, Member, Turn};
+use super::cluster::{Chunk, Coarse, Member, Turn};
 use super::partition::{Partition, Slot};
 use super::path_ball;
 use super::rounds::RoundStats;
 use crate::physics::broad::Grid;
-use crate::physics::exec::{Exec, Serial, for_each_block};
+use crate::physics::exec::{Exec, Serial};
 use crate::physics::sphere::Sphere;
 use glam::DVec3;
-use parking_lot::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// Fewer changed balls than this are compared on one lane.
+/// Fewer grown balls than this are compared on one lane.
 const LANES_MIN_BALLS: usize = 2048;
-/// Below this many spheres with events, the grown-ball check builds a grid
-/// over their balls (a sphere, a grid record and cells: about 170 bytes a
-/// slot, 11 MB at this count); from it on, it searches the step's grid
-/// (8 bytes a changed slot, about three times the check's instructions).
-const OWN_GRID_MAX: usize = 1 << 16;
-/// Changed balls per parallel block of the grown-ball check.
-const BALL_BLOCK: usize = 1024;
-/// The grown-ball check searches the grid a little wider than the balls
-/// need, so rounding never hides a ball; the pair test itself is exact.
-const SEARCH_SLACK: f64 = 1.0 + 1e-9;
 
 /// By slot, what the cluster's last finished run left.
 #[derive(Default)]
@@ -142,20 +131,12 @@ pub(super) struct Conflicts {
     /// (sphere, sphere of another cluster) whose balls met in a standing
     /// run: their paths are compared once the runs agree.
     pub cross: Vec<(u32, u32)>,
-    /// Scratch of the grown-ball check: each slot's cluster; with a grid of
-    /// its own, every slot's ball, that grid, the pairs it found; from the
-    /// step's grid, the changed slots (and whether grown past the grid's
-    /// reach), those grown past it, the conflicts each block of them found.
-    cluster_of: Vec<Slot>,
-    /// Up to how many slots a grid of their own is built ([`OWN_GRID_MAX`]
-    /// unless a test says otherwise).
-    pub own_grid_max: Option<usize>,
+    /// Scratch of the grown-ball check: every slot's ball, a grid over
+    /// them, the pairs it found, each slot's cluster.
     balls: Vec<Sphere>,
     overlap: Grid,
     overlap_pairs: Vec<(u32, u32)>,
-    changed: Vec<(u32, bool)>,
-    big: Vec<u32>,
-    block_found: Vec<Mutex<Vec<(u32, u32)>>>,
+    cluster_of: Vec<Slot>,
 }
 
 impl Conflicts {
@@ -189,9 +170,6 @@ impl Conflicts {
     /// grown balls, or any ball and that of a bystander that joined a run (which
     /// other runs took to fly straight), may meet where no run could see
     /// it: such pairs in different clusters are compared by their paths.
-    /// Either way below finds the same pairs (the grid's pair test, to the
-    /// bit), in another order; the clusters they merge into do not depend
-    /// on it.
     #[allow(clippy::too_many_arguments)]
     pub fn check_grown(
         &mut self,
@@ -199,7 +177,7 @@ impl Conflicts {
         part: &mut Partition,
         fin: &Finished,
         spheres: &[Sphere],
-        (grid, size): (&Grid, f64),
+        size: f64,
         dt: f64,
         stats: &mut RoundStats,
     ) {
@@ -211,27 +189,6 @@ impl Conflicts {
         self.cluster_of.clear();
         self.cluster_of
             .extend((0..m).map(|s| part.find(Slot::at(s))));
-        if m < self.own_grid_max.unwrap_or(OWN_GRID_MAX) {
-            self.grown_by_own_grid(exec, part, fin, spheres, size, dt, stats);
-        } else {
-            self.grown_by_step_grid(exec, part, fin, spheres, grid, dt, stats);
-        }
-    }
-
-    /// [`Conflicts::check_grown`] with a grid over the slots' balls: the
-    /// pairs of any changed ball among them.
-    #[allow(clippy::too_many_arguments)]
-    fn grown_by_own_grid(
-        &mut self,
-        exec: &dyn Exec,
-        part: &Partition,
-        fin: &Finished,
-        spheres: &[Sphere],
-        size: f64,
-        dt: f64,
-        stats: &mut RoundStats,
-    ) {
-        let m = part.ids.len();
         // Every slot's ball, indexed by slot.
         self.balls.clear();
         for s in 0..m {
@@ -273,121 +230,6 @@ impl Conflicts {
                 .push((part.ids[a as usize], part.ids[b as usize]));
         }
         self.overlap_pairs = pairs;
-    }
-
-    /// [`Conflicts::check_grown`] from the step's grid, searched around
-    /// each changed ball: an unchanged ball is the one the grid holds, and
-    /// a changed one grown no further than a run's cap is found as a run
-    /// finds it. Only pairs of balls both grown past their caps are checked
-    /// by hand (they are few). Eight bytes a changed slot, for about three
-    /// times the instructions of a grid over the balls.
-    #[allow(clippy::too_many_arguments)]
-    fn grown_by_step_grid(
-        &mut self,
-        exec: &dyn Exec,
-        part: &Partition,
-        fin: &Finished,
-        spheres: &[Sphere],
-        grid: &Grid,
-        dt: f64,
-        stats: &mut RoundStats,
-    ) {
-        let m = part.ids.len();
-        let first_late = part.first_late;
-        let changed = |s: usize| s >= first_late || fin.grew(s);
-        // The changed slots, and whether each grew past what the grid finds.
-        self.changed.clear();
-        self.big.clear();
-        for s in (0..m).filter(|&s| changed(s)) {
-            let (id, (_, reach)) = (part.ids[s], fin.ball(s, part.ids[s], spheres, dt));
-            let reach0 = path_ball(&spheres[id as usize], dt).1;
-            let big = reach > GROWTH_CAP * grid.widest_in_level(reach0);
-            self.changed.push((s as u32, big));
-            if big {
-                self.big.push(s as u32);
-            }
-        }
-        let (ids, slot, cluster_of) = (&part.ids, &part.slot, &self.cluster_of);
-        let compared = AtomicUsize::new(0);
-        let blocks = self.changed.len().div_ceil(BALL_BLOCK);
-        while self.block_found.len() < blocks {
-            self.block_found.push(Mutex::new(Vec::new()));
-        }
-        let (changed_list, block_found, bigs) = (&self.changed, &self.block_found, &self.big);
-        // In slot order, so searched; almost always empty.
-        let big = |s: usize| bigs.binary_search(&(s as u32)).is_ok();
-        let ball = |s: usize| fin.ball(s, ids[s], spheres, dt);
-        // Pair (a, b) of slots in different clusters whose balls meet:
-        // compared by their paths, noted if they meet.
-        let judge = |(a, pa, ra): (usize, DVec3, f64),
-                     (b, pb, rb): (usize, DVec3, f64),
-                     found: &mut Vec<(u32, u32)>,
-                     n: &mut usize| {
-            if cluster_of[a] == cluster_of[b] {
-                return;
-            }
-            // The test the grid's pair search makes, to the bit.
-            let r = ra + rb;
-            if (pa - pb).length_squared() > r * r {
-                return;
-            }
-            *n += 1;
-            if fin.meet(a, b, spheres, dt) {
-                found.push((ids[a], ids[b]));
-            }
-        };
-        for_each_block(small(exec, self.changed.len()), blocks, &|k| {
-            let mut found = block_found[k].lock();
-            found.clear();
-            let mut n = 0;
-            let end = ((k + 1) * BALL_BLOCK).min(changed_list.len());
-            for &(a, a_big) in &changed_list[k * BALL_BLOCK..end] {
-                let a = a as usize;
-                let (pa, ra) = ball(a);
-                // Each pair once: an unchanged `b` only from here; two
-                // changed ones from the lower, or from the grown one.
-                grid.near(
-                    pa,
-                    ra * SEARCH_SLACK,
-                    GROWTH_CAP * SEARCH_SLACK,
-                    &mut |j, pj, rj| {
-                        let b = slot[j as usize];
-                        if b.is_none() || b.index() == a {
-                            return;
-                        }
-                        let b = b.index();
-                        // An unchanged ball is the grid's, to the bit.
-                        let (pb, rb) = if changed(b) {
-                            if big(b) || !(a_big || a < b) {
-                                return;
-                            }
-                            ball(b)
-                        } else {
-                            (pj, rj)
-                        };
-                        judge((a, pa, ra), (b, pb, rb), &mut found, &mut n);
-                    },
-                );
-            }
-            compared.fetch_add(n, Ordering::Relaxed);
-        });
-        let mut n = 0;
-        let mut found = Vec::new();
-        for (k, &a) in self.big.iter().enumerate() {
-            let (a, (pa, ra)) = (a as usize, ball(a as usize));
-            for &b in &self.big[k + 1..] {
-                let (b, (pb, rb)) = (b as usize, ball(b as usize));
-                judge((a, pa, ra), (b, pb, rb), &mut found, &mut n);
-            }
-        }
-        let compared = compared.into_inner() + n;
-        let before = self.found.len();
-        for f in &self.block_found[..blocks] {
-            self.found.extend_from_slice(&f.lock());
-        }
-        self.found.extend_from_slice(&found);
-        stats.compared += compared;
-        stats.apart += compared - (self.found.len() - before);
     }
 }
 

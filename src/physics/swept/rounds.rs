@@ -210,7 +210,7 @@ impl Rounds {
             }
             if self.conf.found.is_empty() {
                 self.conf
-                    .check_grown(exec, part, fin, spheres, (grid, size), dt, stats);
+                    .check_grown(exec, part, fin, spheres, size, dt, stats);
             }
             if self.conf.found.is_empty() {
                 break;
@@ -399,64 +399,5 @@ impl Rounds {
             self.part.union(self.part.slot[a as usize], sj);
         }
         self.conf.found = conflicts;
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::super::Swept;
-    use crate::physics::{Model, Serial, World};
-    use crate::scene::{SceneSpec, build_world};
-
-    /// A gas at packing 0.25, 3 000 spheres.
-    fn gas() -> World {
-        let spec = SceneSpec {
-            count: Some(3000),
-            radius: Some(0.027),
-            seed: Some(3),
-            ..SceneSpec::default()
-        };
-        build_world(&spec).unwrap()
-    }
-
-    /// The grown-ball check from the step's grid (what a million spheres
-    /// use) finds the conflicts a grid of the slots' own balls finds: the
-    /// same world to the bit, and it did find some.
-    #[test]
-    fn grown_balls_are_checked_alike_from_either_grid() {
-        let (mut own, mut step) = (gas(), gas());
-        let mut by_own = Swept::default();
-        let mut by_step = Swept::default();
-        by_own.rounds.conf.own_grid_max = Some(usize::MAX);
-        by_step.rounds.conf.own_grid_max = Some(0);
-        let (mut compared, mut met) = (0, 0);
-        for _ in 0..30 {
-            by_own.advance(&mut own, 1.0 / 60.0, 1, &Serial);
-            by_step.advance(&mut step, 1.0 / 60.0, 1, &Serial);
-            let (a, b) = (by_own.round_stats(), by_step.round_stats());
-            assert_eq!(
-                (a.clusters, a.rounds, a.reruns),
-                (b.clusters, b.rounds, b.reruns)
-            );
-            compared += b.compared;
-            met += b.compared - b.apart;
-        }
-        assert!(compared > 0 && met > 0, "{compared} compared, {met} met");
-        for (x, y) in own.spheres.iter().zip(&step.spheres) {
-            assert_eq!(
-                x.pos.to_array().map(f64::to_bits),
-                y.pos.to_array().map(f64::to_bits)
-            );
-            assert_eq!(
-                x.vel.to_array().map(f64::to_bits),
-                y.vel.to_array().map(f64::to_bits)
-            );
-        }
-        assert_eq!(own.counters, step.counters);
-        let e = own.kinetic_energy();
-        assert!(
-            (e - gas().kinetic_energy()).abs() <= 1e-12 * e,
-            "energy kept"
-        );
     }
 }
