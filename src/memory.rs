@@ -9,7 +9,7 @@ use crate::physics::ModelKind;
 pub fn sphere_bytes(model: ModelKind) -> u64 {
     match model {
         ModelKind::Discrete => 380,
-        ModelKind::Swept => 373,
+        ModelKind::Swept => 283,
         ModelKind::Exact => 285,
     }
 }

@@ -116,6 +116,9 @@ fn random_or_lattice(
     }
 }
 
+/// The end of a cell's list of spheres in `random`.
+const NO_SPHERE: u32 = u32::MAX;
+
 /// Random sequential placement with a hash grid; `None` when a sphere finds
 /// no free spot in `TRIES` tries.
 fn random(radii: &[f64], size: f64, rng: &mut SceneRng) -> Option<Vec<(DVec3, f64)>> {
@@ -130,7 +133,11 @@ fn random(radii: &[f64], size: f64, rng: &mut SceneRng) -> Option<Vec<(DVec3, f6
     // spheres in one cell would make placement quadratic).
     let cell = (2.0 * rmax).max(size / f64::from(1u32 << 20));
     let key = |p: DVec3| (p / cell).floor().as_ivec3().to_array();
-    let mut grid: HashMap<[i32; 3], Vec<usize>> = HashMap::new();
+    // Each cell's spheres as a list threaded through `next` (the cell keeps
+    // its last one): about 40 bytes a sphere, where a `Vec` per cell took
+    // about 160 (a million spheres took more memory to place than to step).
+    let mut last: HashMap<[i32; 3], u32> = HashMap::with_capacity(radii.len());
+    let mut next: Vec<u32> = Vec::with_capacity(radii.len());
     let mut out: Vec<(DVec3, f64)> = Vec::with_capacity(radii.len());
     for &r in radii {
         let mut placed = false;
@@ -144,18 +151,24 @@ fn random(radii: &[f64], size: f64, rng: &mut SceneRng) -> Option<Vec<(DVec3, f6
             let free = (-1..=1).all(|dx| {
                 (-1..=1).all(|dy| {
                     (-1..=1).all(|dz| {
-                        grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz])
-                            .is_none_or(|v| {
-                                v.iter().all(|&j| {
-                                    let (q, rq) = out[j];
-                                    p.distance_squared(q) >= (r + rq) * (r + rq)
-                                })
-                            })
+                        let mut j = last
+                            .get(&[k[0] + dx, k[1] + dy, k[2] + dz])
+                            .map_or(NO_SPHERE, |&j| j);
+                        while j != NO_SPHERE {
+                            let (q, rq) = out[j as usize];
+                            if p.distance_squared(q) < (r + rq) * (r + rq) {
+                                return false;
+                            }
+                            j = next[j as usize];
+                        }
+                        true
                     })
                 })
             });
             if free {
-                grid.entry(k).or_default().push(out.len());
+                let at = last.entry(k).or_insert(NO_SPHERE);
+                next.push(*at);
+                *at = out.len() as u32;
                 out.push((p, r));
                 placed = true;
                 break;

@@ -127,36 +127,66 @@ impl Ord for Event {
 }
 
 /// A turn in a member's path: from time `t` of the step it is at
-/// `pos + vel (t' - t)`, until its next turn.
+/// `pos + vel (t' - t)`, until its next turn. Its position there is not
+/// kept: contacts change velocities only, so it is the last turn's (or the
+/// start's) position plus that velocity times the time since, to the bit
+/// (see [`Turn::after`]).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Turn {
     pub t: f64,
-    pub pos: DVec3,
     pub vel: DVec3,
 }
 
-/// One member's result of a finished run.
+impl Turn {
+    /// Where a sphere at `pos` at `t0`, flying at `vel`, is at this turn:
+    /// the same sum a run's lazy clock makes.
+    #[inline]
+    pub fn after(&self, pos: DVec3, vel: DVec3, t0: f64) -> DVec3 {
+        pos + vel * (self.t - t0)
+    }
+}
+
+/// One member's result of a finished run: only what the rounds read (its
+/// radius, mass and the centre of its ball are the start's, found there).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Member {
     pub id: u32,
-    /// Its slot among the spheres with events when the run began
-    /// (`Slot::NONE` for a bystander that joined the run).
-    pub slot: Slot,
-    pub sphere: Sphere,
+    /// Its end of the step.
+    pub pos: DVec3,
+    pub vel: DVec3,
     /// Momentum given to the walls, for the pressure.
     pub wall_momentum: f64,
     pub wall_hits: u32,
     /// Sphere–sphere collisions this member was the lower id of.
     pub pair_hits: u32,
-    /// The ball its whole path of the step stays in, and whether that grew
-    /// past the ball the grid holds for it.
-    pub centre: DVec3,
+    /// The reach of the ball (around its start's path ball's centre) its
+    /// whole path of the step stays in, and whether that grew past the
+    /// ball the grid holds for it.
     pub reach: f64,
     pub grew: bool,
     /// Its turns: `turns` of them from `turn0` on, in time order, in the
-    /// run's [`Run::turns`] (then wherever the caller copies them).
+    /// [`Chunk`] it was written to.
     pub turn0: u32,
     pub turns: u32,
+}
+
+/// Finished runs' members and their turns, as written by [`Run::emit`].
+#[derive(Default)]
+pub(super) struct Chunk {
+    pub members: Vec<Member>,
+    pub turns: Vec<Turn>,
+}
+
+impl Chunk {
+    pub fn clear(&mut self) {
+        self.members.clear();
+        self.turns.clear();
+    }
+
+    /// The turns of `m`, one of this chunk's members.
+    pub fn path(&self, m: &Member) -> &[Turn] {
+        &self.turns[m.turn0 as usize..(m.turn0 + m.turns) as usize]
+    }
 }
 
 /// Scratch for one run, kept to reuse memory.
@@ -182,10 +212,8 @@ pub(super) struct Run {
     heap: BinaryHeap<Event>,
     found: Vec<u32>,
     /// Turns, by local index, in the order they happened; sorted by member
-    /// when the run ends.
+    /// when the run is written out.
     turn_log: Vec<(u32, Turn)>,
-    turns: Vec<Turn>,
-    turn_at: Vec<(u32, u32)>,
     /// (member, member of another cluster) whose balls met: the caller
     /// compares their paths when both runs are done.
     pub cross: Vec<(u32, u32)>,
@@ -286,54 +314,41 @@ impl Run {
             self.wall_momentum[l] += imp;
             self.wall_hits[l] += hits as u32;
         }
-        // Each member's turns together, still in time order (stable sort).
-        self.turn_log.sort_by_key(|&(l, _)| l);
-        self.turns.clear();
-        self.turn_at.clear();
-        self.turn_at.resize(self.ids.len(), (0, 0));
-        for &(l, k) in &self.turn_log {
-            let at = &mut self.turn_at[l as usize];
-            if at.1 == 0 {
-                at.0 = self.turns.len() as u32;
-            }
-            at.1 += 1;
-            self.turns.push(k);
-        }
     }
 
     /// Member `l` changed velocity at `t` (it is there now).
     fn turn(&mut self, l: usize, t: f64) {
         let s = &self.sp[l];
-        self.turn_log.push((
-            l as u32,
-            Turn {
-                t,
+        self.turn_log.push((l as u32, Turn { t, vel: s.vel }));
+    }
+
+    /// Writes the members of the last finished run, each with its turns
+    /// together in time order, to `out`.
+    pub fn emit(&mut self, out: &mut Chunk) {
+        // Stable: each member's turns stay in time order.
+        self.turn_log.sort_by_key(|&(l, _)| l);
+        let base = out.turns.len();
+        out.turns.extend(self.turn_log.iter().map(|&(_, k)| k));
+        let mut k = 0;
+        for l in 0..self.ids.len() {
+            let first = k;
+            while k < self.turn_log.len() && self.turn_log[k].0 as usize == l {
+                k += 1;
+            }
+            let s = &self.sp[l];
+            out.members.push(Member {
+                id: self.ids[l],
                 pos: s.pos,
                 vel: s.vel,
-            },
-        ));
-    }
-
-    /// The turns of the last finished run's members (see [`Member::turn0`]).
-    pub fn turns(&self) -> &[Turn] {
-        &self.turns
-    }
-
-    /// The members of the last finished run.
-    pub fn members(&self) -> impl Iterator<Item = Member> + '_ {
-        (0..self.ids.len()).map(|l| Member {
-            id: self.ids[l],
-            slot: self.slots[l],
-            sphere: self.sp[l],
-            wall_momentum: self.wall_momentum[l],
-            wall_hits: self.wall_hits[l],
-            pair_hits: self.pair_hits[l],
-            centre: self.centre[l],
-            reach: self.reach[l],
-            grew: self.reach[l] > self.reach0[l],
-            turn0: self.turn_at[l].0,
-            turns: self.turn_at[l].1,
-        })
+                wall_momentum: self.wall_momentum[l],
+                wall_hits: self.wall_hits[l],
+                pair_hits: self.pair_hits[l],
+                reach: self.reach[l],
+                grew: self.reach[l] > self.reach0[l],
+                turn0: (base + first) as u32,
+                turns: (k - first) as u32,
+            });
+        }
     }
 
     fn clear(&mut self, n: usize) {

@@ -3,7 +3,7 @@
 //! (noted by a run, or grown balls found by a grid over all of them) are
 //! compared turn by turn, and those that come within touching distance are
 //! conflicts: their clusters merge and run again.
-use super::cluster::{Coarse, Member, Turn};
+use super::cluster::{Chunk, Coarse, Member, Turn};
 use super::partition::{Partition, Slot};
 use super::path_ball;
 use super::rounds::RoundStats;
@@ -19,32 +19,83 @@ const LANES_MIN_BALLS: usize = 2048;
 /// By slot, what the cluster's last finished run left.
 #[derive(Default)]
 pub(super) struct Finished {
-    /// The member's end of the step and path (None until its cluster ran).
-    pub out: Vec<Option<Member>>,
+    /// Where the member's record is: (chunk, index in it), `NO_RECORD`
+    /// until its cluster ran.
+    at: Vec<(u32, u32)>,
     /// Whether (and why) that run was capped.
     pub capped: Vec<Option<Coarse>>,
     /// The round that run was made in (NONE before any).
     pub ran: Vec<u32>,
-    /// Every finished member's turns (`Member::turn0` indexes here).
-    pub turns: Vec<Turn>,
+    /// Whether the member's ball grew past the one the grid holds for it.
+    grew: Vec<bool>,
+    /// The runs' outputs, each taken whole from the block that wrote it
+    /// (not copied: a record and its turns are kept once). Not pooled for
+    /// reuse: chunks of any size would each keep the largest they ever held.
+    chunks: Vec<Chunk>,
 }
+
+const NO_RECORD: (u32, u32) = (u32::MAX, u32::MAX);
 
 impl Finished {
     pub fn reset(&mut self, m: usize) {
-        self.out.clear();
-        self.out.resize(m, None);
+        self.at.clear();
+        self.at.resize(m, NO_RECORD);
         self.capped.clear();
         self.capped.resize(m, None);
         self.ran.clear();
         self.ran.resize(m, super::NONE);
-        self.turns.clear();
+        self.grew.clear();
+        self.grew.resize(m, false);
+        self.chunks.clear();
+    }
+
+    /// Drops every record: all the slots are about to run again as one
+    /// cluster, so none is read again, and its memory is free for theirs.
+    pub fn forget(&mut self) {
+        self.at.fill(NO_RECORD);
+        self.grew.fill(false);
+        self.chunks.clear();
     }
 
     /// Room for a slot added after the first round.
     pub fn push(&mut self) {
-        self.out.push(None);
+        self.at.push(NO_RECORD);
         self.capped.push(None);
         self.ran.push(super::NONE);
+        self.grew.push(false);
+    }
+
+    /// Takes a block's chunk in, at its size (it grew by doubling); returns
+    /// its number, for [`Finished::set`].
+    pub fn keep(&mut self, mut chunk: Chunk) -> u32 {
+        chunk.members.shrink_to_fit();
+        chunk.turns.shrink_to_fit();
+        self.chunks.push(chunk);
+        (self.chunks.len() - 1) as u32
+    }
+
+    /// Slot `s` finished as member `k` of chunk `c`.
+    pub fn set(&mut self, s: usize, c: u32, k: usize) {
+        self.at[s] = (c, k as u32);
+        self.grew[s] = self.record_in(c, k).is_some_and(|(m, _)| m.grew);
+    }
+
+    /// Slot `s`'s record and its turns, if its cluster ran.
+    pub fn record(&self, s: usize) -> Option<(&Member, &[Turn])> {
+        let (c, k) = self.at[s];
+        self.record_in(c, k as usize)
+    }
+
+    /// Member `k` of chunk `c` and its turns.
+    pub fn record_in(&self, c: u32, k: usize) -> Option<(&Member, &[Turn])> {
+        let chunk = self.chunks.get(c as usize)?;
+        let m = chunk.members.get(k)?;
+        Some((m, chunk.path(m)))
+    }
+
+    /// Whether slot `s`'s ball grew past the one the grid holds for it.
+    pub fn grew(&self, s: usize) -> bool {
+        self.grew[s]
     }
 
     /// Whether the spheres of slots `a` and `b` come within touching
@@ -52,8 +103,7 @@ impl Finished {
     /// or one not run) meets everyone: a merge costs time, never a result.
     fn meet(&self, a: usize, b: usize, spheres: &[Sphere], dt: f64) -> bool {
         let path = |s: usize| {
-            let m = self.out[s].filter(|_| self.capped[s].is_none())?;
-            let turns = &self.turns[m.turn0 as usize..(m.turn0 + m.turns) as usize];
+            let (m, turns) = self.record(s).filter(|_| self.capped[s].is_none())?;
             Some((&spheres[m.id as usize], turns))
         };
         let (Some((sa, ta)), Some((sb, tb))) = (path(a), path(b)) else {
@@ -63,11 +113,12 @@ impl Finished {
     }
 
     /// The ball slot `s` (sphere `id`) stays in: from its last finished
-    /// run, or its straight path.
+    /// run (around the same centre), or its straight path.
     fn ball(&self, s: usize, id: u32, spheres: &[Sphere], dt: f64) -> (DVec3, f64) {
-        match &self.out[s] {
-            Some(m) => (m.centre, m.reach),
-            None => path_ball(&spheres[id as usize], dt),
+        let straight = path_ball(&spheres[id as usize], dt);
+        match self.record(s) {
+            Some((m, _)) => (straight.0, m.reach),
+            None => straight,
         }
     }
 }
@@ -131,10 +182,13 @@ impl Conflicts {
         stats: &mut RoundStats,
     ) {
         let m = part.ids.len();
-        let any_changed = m > part.first_late || fin.out.iter().any(|o| o.is_some_and(|o| o.grew));
-        if !any_changed || m < 2 {
+        if m < 2 || !(m > part.first_late || (0..m).any(|s| fin.grew(s))) {
             return;
         }
+        // Merges since the round began joined clusters: name them afresh.
+        self.cluster_of.clear();
+        self.cluster_of
+            .extend((0..m).map(|s| part.find(Slot::at(s))));
         // Every slot's ball, indexed by slot.
         self.balls.clear();
         for s in 0..m {
@@ -146,10 +200,6 @@ impl Conflicts {
                 mass: 0.0,
             });
         }
-        // Merges since the round began joined clusters: name them afresh.
-        self.cluster_of.clear();
-        self.cluster_of
-            .extend((0..m).map(|s| part.find(Slot::at(s))));
         self.overlap.build(
             &self.balls,
             size,
@@ -160,7 +210,7 @@ impl Conflicts {
         let cluster_of = &self.cluster_of;
         let compared = AtomicUsize::new(0);
         let first_late = part.first_late;
-        let changed = |s: usize| s >= first_late || fin.out[s].is_some_and(|o| o.grew);
+        let changed = |s: usize| s >= first_late || fin.grew(s);
         // The paths are compared in the pair search, on its lanes.
         let meet = |a: u32, b: u32| {
             let (sa, sb) = (a as usize, b as usize);
@@ -199,11 +249,23 @@ const PATH_MARGIN: f64 = 1e-8;
 /// radii (widened by [`PATH_MARGIN`]) at one moment of `0..=dt`: on each
 /// stretch where both fly straight, the closest approach of the two lines.
 fn paths_meet(a: &Sphere, ta: &[Turn], b: &Sphere, tb: &[Turn], dt: f64) -> bool {
+    /// A stretch of a path: from time `t` at `pos`, flying at `vel`.
+    #[derive(Clone, Copy)]
+    struct Leg {
+        t: f64,
+        pos: DVec3,
+        vel: DVec3,
+    }
     let sigma = (a.radius + b.radius) * (1.0 + PATH_MARGIN);
-    let start = |s: &Sphere| Turn {
+    let start = |s: &Sphere| Leg {
         t: 0.0,
         pos: s.pos,
         vel: s.vel,
+    };
+    let turn = |l: Leg, k: &Turn| Leg {
+        t: k.t,
+        pos: k.after(l.pos, l.vel, l.t),
+        vel: k.vel,
     };
     let (mut ka, mut kb) = (start(a), start(b));
     let (mut ia, mut ib) = (0, 0);
@@ -226,11 +288,11 @@ fn paths_meet(a: &Sphere, ta: &[Turn], b: &Sphere, tb: &[Turn], dt: f64) -> bool
             return false;
         }
         while ia < ta.len() && ta[ia].t <= t1 {
-            ka = ta[ia];
+            ka = turn(ka, &ta[ia]);
             ia += 1;
         }
         while ib < tb.len() && tb[ib].t <= t1 {
-            kb = tb[ib];
+            kb = turn(kb, &tb[ib]);
             ib += 1;
         }
         t0 = t1;
@@ -250,10 +312,11 @@ mod tests {
         }
     }
 
-    fn turn(t: f64, pos: [f64; 3], vel: [f64; 3]) -> Turn {
+    /// A turn at `t` to `vel`; where the path is then follows from its
+    /// start and earlier turns.
+    fn turn(t: f64, vel: [f64; 3]) -> Turn {
         Turn {
             t,
-            pos: DVec3::from(pos),
             vel: DVec3::from(vel),
         }
     }
@@ -282,8 +345,8 @@ mod tests {
         // and straight it passes 1 away.
         let a = sphere([-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
         let b = sphere([0.0, 1.0, 0.0], [0.0, 0.0, 0.0]);
-        let up = [turn(1.0, [0.0, 0.0, 0.0], [0.0, 1.0, 0.0])];
-        let down = [turn(1.0, [0.0, 0.0, 0.0], [0.0, -1.0, 0.0])];
+        let up = [turn(1.0, [0.0, 1.0, 0.0])];
+        let down = [turn(1.0, [0.0, -1.0, 0.0])];
         assert!(!paths_meet(&a, &[], &b, &[], 3.0));
         assert!(paths_meet(&a, &up, &b, &[], 3.0));
         assert!(paths_meet(&b, &[], &a, &up, 3.0), "either order");
@@ -291,7 +354,7 @@ mod tests {
         // The meeting at t = 1.8 lies past a step of 1.5.
         assert!(!paths_meet(&a, &up, &b, &[], 1.5));
         // Both turn: `b` runs off along +y at t = 0.5 and stays ahead.
-        let away = [turn(0.5, [0.0, 1.0, 0.0], [0.0, 2.0, 0.0])];
+        let away = [turn(0.5, [0.0, 2.0, 0.0])];
         assert!(!paths_meet(&a, &up, &b, &away, 3.0));
     }
 }

@@ -280,7 +280,8 @@ impl Swept {
         let c = &mut world.counters;
         let mut capped = None;
         for (m, cap) in self.rounds.results() {
-            world.spheres[m.id as usize] = m.sphere;
+            let s = &mut world.spheres[m.id as usize];
+            (s.pos, s.vel) = (m.pos, m.vel);
             c.wall_momentum += m.wall_momentum;
             c.sphere_collisions += u64::from(m.pair_hits);
             c.wall_collisions += u64::from(m.wall_hits);

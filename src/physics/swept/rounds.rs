@@ -26,7 +26,7 @@
 //!
 //! Here: the rounds and the runs of each. The clusters themselves are in
 //! `partition.rs`, the path comparison and grown balls in `conflicts.rs`.
-use super::cluster::{Coarse, Member, Run, Shared};
+use super::cluster::{Chunk, Coarse, Member, Run, Shared};
 use super::conflicts::{Conflicts, Finished};
 use super::partition::{Batch, Partition, Slot};
 use crate::physics::broad::Grid;
@@ -49,12 +49,11 @@ const PERCOLATION: (usize, usize) = (3, 10);
 /// What one block of clusters left.
 #[derive(Default)]
 struct BlockOut {
-    /// Finished clusters: (why capped, how many of `members` are theirs,
-    /// the work the run did).
+    /// Finished clusters: (why capped, how many of the chunk's members are
+    /// theirs, the work the run did).
     done: Vec<(Option<Coarse>, u32, u64)>,
-    members: Vec<Member>,
-    /// The members' turns (`Member::turn0` indexes here).
-    turns: Vec<super::cluster::Turn>,
+    /// Their members and turns, taken whole into `Finished` when collected.
+    chunk: Chunk,
     /// Finished runs' (member, member of another cluster) to compare.
     cross: Vec<(u32, u32)>,
 }
@@ -123,7 +122,7 @@ impl Rounds {
     pub fn results(&self) -> impl Iterator<Item = (&Member, Option<Coarse>)> {
         self.in_order.iter().map(|&s| {
             let s = s.index();
-            let Some(m) = self.fin.out[s].as_ref() else {
+            let Some((m, _)) = self.fin.record(s) else {
                 unreachable!("every involved sphere finished");
             };
             (m, self.fin.capped[s])
@@ -157,6 +156,7 @@ impl Rounds {
             let mut absorb = serial || round >= PARALLEL_ROUNDS;
             if absorb {
                 self.part.merge_all();
+                self.fin.forget();
             }
             let first = self.stats.rounds == 0;
             self.part.partition(meets, first, &mut self.batch);
@@ -165,6 +165,7 @@ impl Rounds {
             if !absorb && round > 0 && 2 * self.batch.order.len() > self.part.ids.len() {
                 absorb = true;
                 self.part.merge_all();
+                self.fin.forget();
                 self.part.partition(meets, first, &mut self.batch);
             }
             if self.batch.todo.is_empty() {
@@ -293,23 +294,25 @@ impl Rounds {
             for b in next_blocks(&next, blocks) {
                 let mut out = outs[b].lock();
                 out.done.clear();
-                out.members.clear();
-                out.turns.clear();
+                out.chunk.clear();
                 out.cross.clear();
                 let end = ((b + 1) * CLUSTER_BLOCK).min(todo.len());
+                // The chunk is new (the last went to `Finished`): room for
+                // about what its runs write at once, not grown by doubling.
+                let members: usize = todo[b * CLUSTER_BLOCK..end]
+                    .iter()
+                    .map(|t| (t.m1 - t.m0) as usize)
+                    .sum();
+                out.chunk.members.reserve_exact(members + members / 8);
+                out.chunk.turns.reserve_exact(2 * members);
                 for t in &todo[b * CLUSTER_BLOCK..end] {
                     let members = &order[t.m0 as usize..t.m1 as usize];
                     let cp = &pairs[t.p0 as usize..t.p1 as usize];
                     run.run(sh, members, cp, absorb);
-                    let before = out.members.len();
-                    let base = out.turns.len() as u32;
-                    out.turns.extend_from_slice(run.turns());
-                    out.members.extend(run.members().map(|mut m| {
-                        m.turn0 += base;
-                        m
-                    }));
+                    let before = out.chunk.members.len();
+                    run.emit(&mut out.chunk);
                     out.cross.extend_from_slice(&run.cross);
-                    let len = (out.members.len() - before) as u32;
+                    let len = (out.chunk.members.len() - before) as u32;
                     out.done.push((run.capped, len, run.work));
                 }
             }
@@ -325,31 +328,36 @@ impl Rounds {
         let known = self.part.ids.len();
         let mut cross = std::mem::take(&mut self.conf.cross);
         let fresh = cross.len();
-        let outs = std::mem::take(&mut self.outs);
-        for block in &outs[..self.batch.todo.len().div_ceil(CLUSTER_BLOCK)] {
-            let out = block.lock();
+        let mut outs = std::mem::take(&mut self.outs);
+        for block in &mut outs[..self.batch.todo.len().div_ceil(CLUSTER_BLOCK)] {
+            let out = block.get_mut();
+            let chunk = std::mem::take(&mut out.chunk);
+            let c = self.fin.keep(chunk);
             let mut k = 0usize;
             for &(capped, len, work) in &out.done {
                 self.work += work;
-                let members = &out.members[k..k + len as usize];
-                k += len as usize;
+                let (k0, k1) = (k, k + len as usize);
+                k = k1;
                 // Bystanders that joined a run are its members now.
                 let mut root = Slot::NONE;
                 let mut twice = false;
-                for m in members {
-                    // The run read the slot when it began; a bystander that
-                    // joined may have got one from an earlier run of this round.
-                    let s = match (m.slot, self.part.slot[m.id as usize]) {
-                        (Slot::NONE, Slot::NONE) => self.add_slot(m.id),
-                        (Slot::NONE, s) | (s, _) => s,
+                let mut first = None;
+                for at in k0..k1 {
+                    let Some((m, _)) = self.fin.record_in(c, at) else {
+                        unreachable!("a chunk holds the members its runs wrote");
+                    };
+                    let id = m.id;
+                    first.get_or_insert(id);
+                    // A bystander that joined this run may have got a slot
+                    // from an earlier run of this round (or none yet).
+                    let s = match self.part.slot[id as usize] {
+                        Slot::NONE => self.add_slot(id),
+                        s => s,
                     };
                     // Joined an earlier run of this round too: the two
                     // runs join (below) and run again.
                     twice |= s.index() >= known && self.fin.ran[s.index()] == round;
-                    let path = &out.turns[m.turn0 as usize..(m.turn0 + m.turns) as usize];
-                    let turn0 = self.fin.turns.len() as u32;
-                    self.fin.turns.extend_from_slice(path);
-                    self.fin.out[s.index()] = Some(Member { turn0, ..*m });
+                    self.fin.set(s.index(), c, at);
                     self.fin.capped[s.index()] = capped;
                     self.fin.ran[s.index()] = round;
                     root = if root.is_none() {
@@ -360,7 +368,9 @@ impl Rounds {
                 }
                 if twice {
                     self.part.union(root, root);
-                    let first = members[0].id;
+                    let Some(first) = first else {
+                        unreachable!("a run that joined another has members");
+                    };
                     self.conf.found.push((first, first));
                 } else {
                     self.part.ran(root);
