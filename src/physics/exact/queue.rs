@@ -61,23 +61,45 @@ pub struct Tournament {
     /// spheres apart, so a climb carries the winning key in a register and
     /// only the keys are on its chain of dependent steps.
     keys: Vec<u64>,
+    /// The sphere of each inner node (`1..size`); a leaf's is its place.
     ids: Vec<u32>,
     size: usize,
 }
 
-/// One step of a climb from node `k` (of a power-of-two tree, `mask` its
-/// length less one), which holds `w`: set its parent, and return the
-/// parent's key. Ties go left (lower indices), so a left sibling wins
-/// a tie too: hence the `+ (k & 1)`. Every index is below the length, so the
-/// masks change none and let the compiler drop the bounds checks.
+/// One step of a climb from inner node `k` (of a power-of-two tree, `mask`
+/// the keys' length less one, `imask` the ids'), which holds `w`: set its
+/// parent, and return the parent's key. Ties go left (lower indices), so a
+/// left sibling wins a tie too: hence the `+ (k & 1)`. Every index is below
+/// its array's length, so the masks change none and let the compiler drop
+/// the bounds checks.
 #[inline(always)]
-fn step(keys: &mut [u64], ids: &mut [u32], mask: usize, k: usize, w: u64) -> u64 {
+fn step(keys: &mut [u64], ids: &mut [u32], (mask, imask): (usize, usize), k: usize, w: u64) -> u64 {
     let s = keys[(k ^ 1) & mask];
     let sib = s < w.wrapping_add((k & 1) as u64);
     let w = w ^ ((w ^ s) & 0u64.wrapping_sub(sib as u64));
-    let id = ids[(k ^ sib as usize) & mask];
+    let id = ids[(k ^ sib as usize) & imask];
     keys[(k >> 1) & mask] = w;
-    ids[(k >> 1) & mask] = id;
+    ids[(k >> 1) & imask] = id;
+    w
+}
+
+/// The first step of a climb, from leaf `k` of a tree of `size` leaves: as
+/// [`step`], but a leaf's sphere is its place, `k - size`, so leaves keep
+/// no id (4 bytes a sphere less, and one store less an update).
+#[inline(always)]
+fn leaf_step(
+    keys: &mut [u64],
+    ids: &mut [u32],
+    (mask, imask): (usize, usize),
+    k: usize,
+    w: u64,
+    size: usize,
+) -> u64 {
+    let s = keys[(k ^ 1) & mask];
+    let sib = s < w.wrapping_add((k & 1) as u64);
+    let w = w ^ ((w ^ s) & 0u64.wrapping_sub(sib as u64));
+    keys[(k >> 1) & mask] = w;
+    ids[(k >> 1) & imask] = ((k ^ sib as usize) - size) as u32;
     w
 }
 
@@ -93,17 +115,14 @@ impl EventQueue for Tournament {
         self.keys.capacity() * 8 + self.ids.capacity() * 4
     }
 
-    /// A queue for spheres `0..n`, every event at infinity (each leaf holds
+    /// A queue for spheres `0..n`, every event at infinity (each leaf is
     /// its sphere, so ties at infinity go to the lowest index too).
     fn reset(&mut self, n: usize) {
         self.size = n.next_power_of_two().max(1);
         self.keys.clear();
         self.keys.resize(2 * self.size, key(f64::INFINITY));
         self.ids.clear();
-        self.ids.resize(2 * self.size, u32::MAX);
-        for (i, id) in self.ids[self.size..self.size + n].iter_mut().enumerate() {
-            *id = i as u32;
-        }
+        self.ids.resize(self.size.max(2), 0);
         self.rebuild();
     }
 
@@ -111,14 +130,18 @@ impl EventQueue for Tournament {
     #[inline]
     fn set_leaf(&mut self, i: usize, t: f64) {
         self.keys[self.size + i] = key(t);
-        self.ids[self.size + i] = i as u32;
     }
 
     fn rebuild(&mut self) {
         for k in (1..self.size).rev() {
             let right = (self.keys[2 * k + 1] < self.keys[2 * k]) as usize;
-            self.keys[k] = self.keys[2 * k + right];
-            self.ids[k] = self.ids[2 * k + right];
+            let child = 2 * k + right;
+            self.keys[k] = self.keys[child];
+            self.ids[k] = if child >= self.size {
+                (child - self.size) as u32
+            } else {
+                self.ids[child]
+            };
         }
     }
 
@@ -127,15 +150,19 @@ impl EventQueue for Tournament {
     /// either the stop or the comparison is taken at random.
     #[inline]
     fn update(&mut self, i: usize, t: f64) {
-        let mut k = self.size + i;
-        let Some((keys, ids, mask)) = self.nodes() else {
+        let size = self.size;
+        let mut k = size + i;
+        let Some((keys, ids, masks)) = self.nodes() else {
             return;
         };
         let mut w = key(t);
-        keys[k & mask] = w;
-        ids[k & mask] = i as u32;
+        keys[k & masks.0] = w;
+        if k > 1 {
+            w = leaf_step(keys, ids, masks, k, w, size);
+            k >>= 1;
+        }
         while k > 1 {
-            w = step(keys, ids, mask, k, w);
+            w = step(keys, ids, masks, k, w);
             k >>= 1;
         }
     }
@@ -148,26 +175,31 @@ impl EventQueue for Tournament {
             self.update(i, ti);
             return self.update(j, tj);
         }
-        let (mut a, mut b) = (self.size + i, self.size + j);
-        let Some((keys, ids, mask)) = self.nodes() else {
+        let size = self.size;
+        let (mut a, mut b) = (size + i, size + j);
+        let Some((keys, ids, masks)) = self.nodes() else {
             return;
         };
         let (mut wa, mut wb) = (key(ti), key(tj));
-        keys[a & mask] = wa;
-        ids[a & mask] = i as u32;
-        keys[b & mask] = wb;
-        ids[b & mask] = j as u32;
+        keys[a & masks.0] = wa;
+        keys[b & masks.0] = wb;
         // Both nodes of a level are set before either parent is taken, so
-        // a parent the two share sees both.
+        // a parent the two share sees both. Two distinct leaves mean at
+        // least two leaves, so both climb from the leaf level.
+        let pa = leaf_step(keys, ids, masks, a, wa, size);
+        wb = leaf_step(keys, ids, masks, b, wb, size);
+        wa = pa;
+        a >>= 1;
+        b >>= 1;
         while a != b {
-            let pa = step(keys, ids, mask, a, wa);
-            wb = step(keys, ids, mask, b, wb);
+            let pa = step(keys, ids, masks, a, wa);
+            wb = step(keys, ids, masks, b, wb);
             wa = pa;
             a >>= 1;
             b >>= 1;
         }
         while a > 1 {
-            wa = step(keys, ids, mask, a, wa);
+            wa = step(keys, ids, masks, a, wa);
             a >>= 1;
         }
     }
@@ -175,7 +207,9 @@ impl EventQueue for Tournament {
     /// The earliest pending event: time and sphere (time infinite if none).
     #[inline]
     fn peek(&mut self) -> (f64, usize) {
-        (time(self.keys[1]), self.ids[1] as usize)
+        // A tree of one leaf: the root is that leaf, sphere 0.
+        let id = if self.size > 1 { self.ids[1] } else { 0 };
+        (time(self.keys[1]), id as usize)
     }
 
     /// Subtract `shift` from every time (a new time origin); order is kept
@@ -189,15 +223,19 @@ impl EventQueue for Tournament {
 }
 
 impl Tournament {
-    /// The two arrays as slices of one power-of-two length, and that length
+    /// The two arrays as slices of power-of-two lengths, and those lengths
     /// less one (`None` before any reset).
     #[inline(always)]
-    fn nodes(&mut self) -> Option<(&mut [u64], &mut [u32], usize)> {
-        let len = self.keys.len();
+    fn nodes(&mut self) -> Option<(&mut [u64], &mut [u32], (usize, usize))> {
+        let (len, ilen) = (self.keys.len(), self.ids.len());
         if len == 0 {
             return None;
         }
-        Some((&mut self.keys[..len], &mut self.ids[..len], len - 1))
+        Some((
+            &mut self.keys[..len],
+            &mut self.ids[..ilen],
+            (len - 1, ilen - 1),
+        ))
     }
 }
 
