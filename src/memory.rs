@@ -8,9 +8,9 @@ use crate::physics::ModelKind;
 /// packing 0.005 and 0.1, the larger; docs/benchmarks.md has the runs).
 pub fn sphere_bytes(model: ModelKind) -> u64 {
     match model {
-        ModelKind::Discrete => 380,
-        ModelKind::Swept => 283,
-        ModelKind::Exact => 285,
+        ModelKind::Discrete => 243,
+        ModelKind::Swept => 285,
+        ModelKind::Exact => 254,
     }
 }
 
@@ -120,7 +120,7 @@ mod tests {
         assert!(check(1_000_000, Some(ModelKind::Swept), free).is_ok());
         let err = check(10_000_000, Some(ModelKind::Exact), free).unwrap_err();
         assert!(
-            err.starts_with("10000000 spheres would need about 2781 MiB"),
+            err.starts_with("10000000 spheres would need about 2486 MiB"),
             "{err}"
         );
         assert!(

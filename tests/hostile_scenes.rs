@@ -252,7 +252,7 @@ fn tempdir() -> std::path::PathBuf {
 
 #[test]
 fn a_count_the_memory_cannot_hold_is_refused_with_the_figure() {
-    // Under a 600 MB address-space limit: a million spheres need about 336
+    // Under a 600 MB address-space limit: a million spheres need about 306
     // MiB with exact, more than half the limit, so they are refused before
     // the model allocates anything.
     let run = |model: &str| {
