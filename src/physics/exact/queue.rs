@@ -66,6 +66,9 @@ pub struct Tournament {
     size: usize,
 }
 
+/// The keys, the inner nodes' ids, and the two lengths less one.
+type Nodes<'a> = (&'a mut [u64], &'a mut [u32], (usize, usize));
+
 /// One step of a climb from inner node `k` (of a power-of-two tree, `mask`
 /// the keys' length less one, `imask` the ids'), which holds `w`: set its
 /// parent, and return the parent's key. Ties go left (lower indices), so a
@@ -226,7 +229,7 @@ impl Tournament {
     /// The two arrays as slices of power-of-two lengths, and those lengths
     /// less one (`None` before any reset).
     #[inline(always)]
-    fn nodes(&mut self) -> Option<(&mut [u64], &mut [u32], (usize, usize))> {
+    fn nodes(&mut self) -> Option<Nodes<'_>> {
         let (len, ilen) = (self.keys.len(), self.ids.len());
         if len == 0 {
             return None;
