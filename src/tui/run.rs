@@ -260,6 +260,14 @@ impl FrameLoop {
                 let period = Duration::from_secs_f64(1.0 / self.state.fps);
                 next_frame = later(next_frame, period, now);
                 self.frame()?;
+                // With the physics on this thread (`off`), the terminal's
+                // answer to the last frame arrived while it ran: read it
+                // now, or this frame waits for the next one's physics and
+                // a step longer than the period halves the frame rate.
+                for msg in rx.try_iter() {
+                    self.update_wanted |= self.handle(msg)?;
+                }
+                self.present()?;
             } else if self.late && self.engine.frame_ready() {
                 // In place of the frame the physics missed: never more
                 // frames than periods.
