@@ -146,14 +146,20 @@ fn exact_one_with<Q: EventQueue + Send>(args: &[String], model: EventDriven<Q>) 
     );
 }
 
-fn exact_renumber(args: &[String]) {
+/// `N packing rounds [steps]` of the side-by-side runs (20 steps a block
+/// by default).
+fn side_by_side_args(args: &[String]) -> (usize, f64, usize, u64) {
     let num = |k: usize| args.get(k).and_then(|a| a.parse::<f64>().ok());
-    let (n, packing, rounds) = (
+    (
         num(0).expect("N") as usize,
         num(1).expect("packing"),
         num(2).expect("rounds") as usize,
-    );
-    let steps = num(3).map_or(20, |s| s as u64);
+        num(3).map_or(20, |s| s as u64),
+    )
+}
+
+fn exact_renumber(args: &[String]) {
+    let (n, packing, rounds, steps) = side_by_side_args(args);
     let world = exact_scene(n, packing);
     let mut runs = [
         (
@@ -217,13 +223,7 @@ fn timed_block<Q: EventQueue + Send>(
 }
 
 fn exact_queues(args: &[String]) {
-    let num = |k: usize| args.get(k).and_then(|a| a.parse::<f64>().ok());
-    let (n, packing, rounds) = (
-        num(0).expect("N") as usize,
-        num(1).expect("packing"),
-        num(2).expect("rounds") as usize,
-    );
-    let steps = num(3).map_or(20, |s| s as u64);
+    let (n, packing, rounds, steps) = side_by_side_args(args);
     let world = exact_scene(n, packing);
     let (mut wt, mut wc) = (world.clone(), world);
     let mut tree = EventDriven::<Tournament>::default();

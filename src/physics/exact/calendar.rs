@@ -335,20 +335,7 @@ mod tests {
 
     #[test]
     fn pops_in_time_then_index_order() {
-        let mut q = Calendar::default();
-        q.reset(5);
-        for (i, t) in [3.0, 1.0, 2.0, 1.0, 5.0].into_iter().enumerate() {
-            q.set_leaf(i, t);
-        }
-        q.rebuild();
-        let mut order = Vec::new();
-        for _ in 0..5 {
-            let (t, i) = q.peek();
-            order.push((t, i));
-            q.update(i, f64::INFINITY);
-        }
-        assert_eq!(order, [(1.0, 1), (1.0, 3), (2.0, 2), (3.0, 0), (5.0, 4)]);
-        assert_eq!(q.peek(), (f64::INFINITY, 0));
+        super::super::queue::check_pop_order::<Calendar>();
     }
 
     /// Events far past the window wait on the overflow and come back in
