@@ -10,7 +10,7 @@ pub fn sphere_bytes(model: ModelKind) -> u64 {
     match model {
         ModelKind::Discrete => 243,
         ModelKind::Swept => 285,
-        ModelKind::Exact => 254,
+        ModelKind::Exact => 250,
     }
 }
 
@@ -120,7 +120,7 @@ mod tests {
         assert!(check(1_000_000, Some(ModelKind::Swept), free).is_ok());
         let err = check(10_000_000, Some(ModelKind::Exact), free).unwrap_err();
         assert!(
-            err.starts_with("10000000 spheres would need about 2486 MiB"),
+            err.starts_with("10000000 spheres would need about 2448 MiB"),
             "{err}"
         );
         assert!(

@@ -319,7 +319,7 @@ fn renumbering_in_space_changes_nothing_but_labels() {
 /// 85 a sphere), the event and pending records 36.
 #[test]
 fn the_cell_grid_and_the_event_slots_stay_small() {
-    use ballpit::physics::exact::body::Body;
+    use ballpit::physics::exact::body::Bodies;
     use ballpit::physics::exact::cell_grid::{CELLS_PER_SPHERE, CellGrid};
     use ballpit::physics::exact::schedule::Slot;
     use ballpit::scene::{SceneSpec, build_world};
@@ -333,11 +333,7 @@ fn the_cell_grid_and_the_event_slots_stay_small() {
             ..Default::default()
         })
         .unwrap();
-        let bodies: Vec<Body> = w
-            .spheres
-            .iter()
-            .map(|s| Body::from_sphere(s, 0.0))
-            .collect();
+        let bodies = Bodies::from_spheres(w.spheres.iter(), 0.0);
         let mut grid = CellGrid::default();
         grid.build(&bodies, w.size, CELLS_PER_SPHERE);
         let cells = grid.cells() as f64 / bodies.len() as f64;

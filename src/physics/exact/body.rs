@@ -1,29 +1,28 @@
 //! A sphere as the event loop holds it: position valid at its own time stamp
 //! `t` (lazy update: a sphere is moved only when an event touches it or the
-//! frame asks for positions). One cache line, so checking a neighbour costs
-//! one line; masses live apart because only collisions read them.
+//! frame asks for positions), its collision count and its species. One
+//! cache line, so checking a neighbour, and whether a prediction about it
+//! still holds, costs one line; radii and masses live in the small
+//! [`SpeciesTable`].
+use super::species::{Species, SpeciesTable};
 use crate::physics::sphere::Sphere;
 use glam::DVec3;
+use std::ops::{Deref, DerefMut};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C, align(64))]
 pub struct Body {
     pub pos: DVec3,
     pub vel: DVec3,
     /// Time (from the model's time origin) at which `pos` holds.
     pub t: f64,
-    pub radius: f64,
+    /// Collisions so far (sphere or wall): a prediction naming this sphere
+    /// as partner holds while its count is the one it saw.
+    pub count: u32,
+    pub species: u32,
 }
 
 impl Body {
-    pub fn from_sphere(s: &Sphere, t: f64) -> Self {
-        Body {
-            pos: s.pos,
-            vel: s.vel,
-            t,
-            radius: s.radius,
-        }
-    }
-
     /// Where the sphere is at time `t`, without moving it.
     #[inline(always)]
     pub fn pos_at(&self, t: f64) -> DVec3 {
@@ -36,15 +35,97 @@ impl Body {
         self.pos += self.vel * (t - self.t);
         self.t = t;
     }
+}
 
-    /// A [`Sphere`] view, so the shared contact code applies unchanged.
+/// The bodies in label order, with the table of their species.
+#[derive(Clone, Debug, Default)]
+pub struct Bodies {
+    list: Vec<Body>,
+    species: SpeciesTable,
+}
+
+impl Bodies {
+    /// The spheres, in this order, at time stamp `t`, every count zero.
+    pub fn from_spheres<'a>(spheres: impl Iterator<Item = &'a Sphere>, t: f64) -> Self {
+        let mut species = SpeciesTable::default();
+        let list = spheres
+            .map(|s| Body {
+                pos: s.pos,
+                vel: s.vel,
+                t,
+                count: 0,
+                species: species.name(s.radius, s.mass),
+            })
+            .collect();
+        species.seal();
+        Bodies { list, species }
+    }
+
     #[inline(always)]
-    pub fn sphere(&self, mass: f64) -> Sphere {
+    pub fn species_of(&self, b: &Body) -> Species {
+        self.species.get(b.species)
+    }
+
+    #[inline(always)]
+    pub fn radius_of(&self, b: &Body) -> f64 {
+        self.species.get(b.species).radius
+    }
+
+    #[inline(always)]
+    pub fn radius(&self, i: usize) -> f64 {
+        self.radius_of(&self.list[i])
+    }
+
+    #[inline(always)]
+    pub fn mass(&self, i: usize) -> f64 {
+        self.species.get(self.list[i].species).mass
+    }
+
+    /// A [`Sphere`] view of body `i`, so the shared contact code applies
+    /// unchanged.
+    #[inline(always)]
+    pub fn sphere(&self, i: usize) -> Sphere {
+        let b = &self.list[i];
+        let Species { radius, mass } = self.species_of(b);
         Sphere {
-            pos: self.pos,
-            vel: self.vel,
-            radius: self.radius,
+            pos: b.pos,
+            vel: b.vel,
+            radius,
             mass,
         }
+    }
+
+    /// The bodies, to be put in a new order.
+    pub fn list_mut(&mut self) -> &mut Vec<Body> {
+        &mut self.list
+    }
+
+    /// Bytes held on the heap.
+    pub fn heap_bytes(&self) -> usize {
+        self.list.capacity() * size_of::<Body>() + self.species.heap_bytes()
+    }
+}
+
+impl Deref for Bodies {
+    type Target = [Body];
+    fn deref(&self) -> &[Body] {
+        &self.list
+    }
+}
+
+impl DerefMut for Bodies {
+    fn deref_mut(&mut self) -> &mut [Body] {
+        &mut self.list
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_body_is_one_cache_line() {
+        assert_eq!(size_of::<Body>(), 64);
+        assert_eq!(align_of::<Body>(), 64);
     }
 }

@@ -2,7 +2,7 @@
 //! the bulk stay out of the grid (every small sphere checks them; a large
 //! one scans the cells over its own reach plus a skin and rescans when it
 //! leaves that skin), so radii 100x apart stay cheap.
-use super::body::Body;
+use super::body::Bodies;
 use glam::DVec3;
 
 /// A sphere counts as large (second level) above this multiple of the bulk radius.
@@ -11,9 +11,9 @@ pub const BIG_FACTOR: f64 = 3.0;
 /// Spheres larger than `factor` times the bulk (98th percentile) radius go
 /// to the second level. Returns that threshold (infinite when the largest
 /// is within it) and the largest radius at or under it. `bodies` is not empty.
-pub fn split_big(bodies: &[Body], factor: f64) -> (f64, f64) {
+pub fn split_big(bodies: &Bodies, factor: f64) -> (f64, f64) {
     let n = bodies.len();
-    let mut radii: Vec<f64> = bodies.iter().map(|b| b.radius).collect();
+    let mut radii: Vec<f64> = bodies.iter().map(|b| bodies.radius_of(b)).collect();
     let k = (n * 98 / 100).min(n - 1);
     let bulk = *radii.select_nth_unstable_by(k, f64::total_cmp).1;
     let rmax = radii.iter().copied().fold(0.0, f64::max);
@@ -24,7 +24,7 @@ pub fn split_big(bodies: &[Body], factor: f64) -> (f64, f64) {
     };
     let small_rmax = bodies
         .iter()
-        .map(|b| b.radius)
+        .map(|b| bodies.radius_of(b))
         .filter(|&r| r <= big_above)
         .fold(0.0, f64::max);
     (big_above, small_rmax)

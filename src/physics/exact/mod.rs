@@ -45,23 +45,22 @@ pub mod body;
 pub mod calendar;
 pub mod cell_grid;
 pub mod large;
-pub mod masses;
 pub mod neighbour_lists;
 mod overlap;
 pub mod queue;
 pub mod renumber;
 pub mod schedule;
+pub mod species;
 
 use super::contact::{reflect_walls, resolve_pair};
 use super::exec::Exec;
 use super::flight::fly;
 use super::model::{Model, ModelKind};
 use super::world::{Counters, World};
-use body::Body;
+use body::Bodies;
 pub use calendar::Calendar;
 use cell_grid::CellGrid;
 use glam::DVec3;
-use masses::Masses;
 use neighbour_lists::NeighbourLists;
 pub use queue::{EventQueue, Tournament};
 use schedule::{Event, Kind, Predictor, Slot};
@@ -122,13 +121,11 @@ pub type Exact = EventDriven<Tournament>;
 /// type parameter, so both run in one binary at no cost to either).
 #[derive(Default)]
 pub struct EventDriven<Q: EventQueue> {
-    bodies: Vec<Body>,
-    mass: Masses,
+    bodies: Bodies,
     /// World index of each body: bodies are kept in a spatial order (sorted
     /// by cell when loaded), so neighbours sit close in memory and a
     /// prediction touches few cache lines.
     order: Vec<u32>,
-    counts: Vec<u32>,
     /// Each sphere's event; in cell mode its best contact or wall event
     /// (absolute time), kept apart from its crossing so a crossing rescans
     /// only new cells, and which of the two the queue holds.
@@ -209,9 +206,8 @@ impl<Q: EventQueue> EventDriven<Q> {
             Broad::Lists(nl) => nl.heap_bytes(),
             Broad::Cells(cells) => cells.heap_bytes(),
         };
-        self.bodies.capacity() * size_of::<Body>()
-            + self.mass.heap_bytes()
-            + (self.order.capacity() + self.counts.capacity() + self.candidates.capacity()) * 4
+        self.bodies.heap_bytes()
+            + (self.order.capacity() + self.candidates.capacity()) * 4
             + self.slots.capacity() * size_of::<Slot>()
             + self.queue.heap_bytes()
             + broad
@@ -233,18 +229,11 @@ impl<Q: EventQueue> EventDriven<Q> {
             && world.size == self.size
             && world.time == self.synced_time
             && world.spheres.len() == self.bodies.len()
-            && self
-                .order
-                .iter()
-                .zip(&self.bodies)
-                .enumerate()
-                .all(|(i, (&k, b))| {
-                    let s = &world.spheres[k as usize];
-                    s.pos == b.pos
-                        && s.vel == b.vel
-                        && s.radius == b.radius
-                        && s.mass == self.mass.get(i)
-                })
+            && self.order.iter().zip(self.bodies.iter()).all(|(&k, b)| {
+                let s = &world.spheres[k as usize];
+                let kind = self.bodies.species_of(b);
+                s.pos == b.pos && s.vel == b.vel && s.radius == kind.radius && s.mass == kind.mass
+            })
     }
 
     fn load(&mut self, world: &World) {
@@ -253,13 +242,8 @@ impl<Q: EventQueue> EventDriven<Q> {
         self.synced_time = world.time;
         self.synced_generation = world.generation();
         self.order = renumber::spatial_order(world.spheres.iter().map(|s| s.pos), world.size);
-        self.bodies.clear();
-        self.bodies.extend(
-            self.order
-                .iter()
-                .map(|&k| Body::from_sphere(&world.spheres[k as usize], 0.0)),
-        );
-        self.mass = Masses::new(self.order.iter().map(|&k| world.spheres[k as usize].mass));
+        self.bodies =
+            Bodies::from_spheres(self.order.iter().map(|&k| &world.spheres[k as usize]), 0.0);
         self.sorted_at = self.stats.crossings + self.stats.relists;
         self.reschedule_all();
     }
@@ -269,8 +253,9 @@ impl<Q: EventQueue> EventDriven<Q> {
     fn reschedule_all(&mut self) {
         self.stats.rebuilds += 1;
         let n = self.bodies.len();
-        self.counts.clear();
-        self.counts.resize(n, 0);
+        for b in self.bodies.iter_mut() {
+            b.count = 0;
+        }
         self.slots.clear();
         self.slots.resize(n, Slot::default());
         // The old broad phase goes first, so a rebuild never holds two.
@@ -278,7 +263,7 @@ impl<Q: EventQueue> EventDriven<Q> {
         let filled: f64 = self
             .bodies
             .iter()
-            .map(|b| crate::physics::sphere::volume(b.radius))
+            .map(|b| crate::physics::sphere::volume(self.bodies.radius_of(b)))
             .sum();
         if filled > LISTS_ABOVE_PACKING * self.size.powi(3) {
             let mut nl = Box::<NeighbourLists>::default();
@@ -310,7 +295,7 @@ impl<Q: EventQueue> EventDriven<Q> {
                     ..Event::default()
                 };
                 let t = nl.relist_time(i, a);
-                let mut p = Predictor::new(a, &self.bodies, &self.counts, self.size, t, relist);
+                let mut p = Predictor::new(a, &self.bodies, self.size, t, relist);
                 for l in nl.of(i) {
                     p.pair(l.j);
                 }
@@ -320,15 +305,8 @@ impl<Q: EventQueue> EventDriven<Q> {
             }
             Broad::Cells(cells) => {
                 let idle = Event::default();
-                let mut p = Predictor::new(
-                    a,
-                    &self.bodies,
-                    &self.counts,
-                    self.size,
-                    f64::INFINITY,
-                    idle,
-                );
-                let n = cells.candidates(i, a, &mut self.candidates);
+                let mut p = Predictor::new(a, &self.bodies, self.size, f64::INFINITY, idle);
+                let n = cells.candidates(i, self.bodies.radius_of(a), &mut self.candidates);
                 for &j in &self.candidates[..n] {
                     if j as usize != i {
                         p.pair(j);
@@ -372,7 +350,7 @@ impl<Q: EventQueue> EventDriven<Q> {
     /// cells needs checking.
     fn after_crossing(&mut self, i: usize, mask: u8) {
         let (tp, evp) = self.slots[i].pending();
-        if evp.kind == Kind::Pair && self.counts[evp.partner as usize] != evp.partner_count {
+        if evp.kind == Kind::Pair && self.bodies[evp.partner as usize].count != evp.partner_count {
             self.schedule(i);
             return;
         }
@@ -380,7 +358,7 @@ impl<Q: EventQueue> EventDriven<Q> {
             unreachable!("crossings only in cell mode")
         };
         let a = &self.bodies[i];
-        let mut p = Predictor::resume(a, &self.bodies, &self.counts, tp - a.t, evp);
+        let mut p = Predictor::resume(a, &self.bodies, tp - a.t, evp);
         let n = cells.new_candidates(i, mask, &mut self.candidates);
         for &j in &self.candidates[..n] {
             p.pair(j);
@@ -397,7 +375,7 @@ impl<Q: EventQueue> EventDriven<Q> {
         if now == 0.0 {
             return;
         }
-        for b in &mut self.bodies {
+        for b in self.bodies.iter_mut() {
             b.advance(now);
             b.t = 0.0;
         }
@@ -430,7 +408,7 @@ impl<Q: EventQueue> EventDriven<Q> {
             match ev.kind {
                 Kind::Pair => {
                     let j = ev.partner as usize;
-                    if self.counts[j] != ev.partner_count {
+                    if self.bodies[j].count != ev.partner_count {
                         self.stats.stale += 1;
                         self.schedule(i);
                         continue;
@@ -444,8 +422,7 @@ impl<Q: EventQueue> EventDriven<Q> {
                 }
                 Kind::Wall => {
                     self.stats.walls += 1;
-                    let b = &mut self.bodies[i];
-                    let mut s = b.sphere(self.mass.get(i));
+                    let mut s = self.bodies.sphere(i);
                     let mask = [ev.mask & 1 != 0, ev.mask & 2 != 0, ev.mask & 4 != 0];
                     for (k, &hit) in mask.iter().enumerate() {
                         if hit && s.vel[k] != 0.0 {
@@ -458,11 +435,12 @@ impl<Q: EventQueue> EventDriven<Q> {
                         }
                     }
                     let (imp, hits) = reflect_walls(&mut s, mask);
+                    let b = &mut self.bodies[i];
                     b.pos = s.pos;
                     b.vel = s.vel;
+                    b.count = b.count.wrapping_add(1);
                     c.wall_momentum += imp;
                     c.wall_collisions += hits;
-                    self.counts[i] = self.counts[i].wrapping_add(1);
                     self.schedule(i);
                 }
                 Kind::Relist => {
@@ -486,8 +464,8 @@ impl<Q: EventQueue> EventDriven<Q> {
     }
 
     fn collide(&mut self, i: usize, j: usize, c: &mut Counters) {
-        let mut a = self.bodies[i].sphere(self.mass.get(i));
-        let mut b = self.bodies[j].sphere(self.mass.get(j));
+        let mut a = self.bodies.sphere(i);
+        let mut b = self.bodies.sphere(j);
         let before = [a.vel, b.vel];
         if resolve_pair(&mut a, &mut b) {
             c.sphere_collisions += 1;
@@ -509,26 +487,28 @@ impl<Q: EventQueue> EventDriven<Q> {
                 });
             }
         }
-        self.bodies[i].vel = a.vel;
-        self.bodies[j].vel = b.vel;
-        self.counts[i] = self.counts[i].wrapping_add(1);
-        self.counts[j] = self.counts[j].wrapping_add(1);
+        for (k, v) in [(i, a.vel), (j, b.vel)] {
+            let body = &mut self.bodies[k];
+            body.vel = v;
+            body.count = body.count.wrapping_add(1);
+        }
     }
 
     /// After a capped step: finish it by free flight with wall bounces.
     fn fly_all(&mut self, target: f64, c: &mut Counters) {
-        for (i, b) in self.bodies.iter_mut().enumerate() {
-            let mut s = b.sphere(self.mass.get(i));
-            let (imp, hits) = fly(&mut s, self.size, target - b.t);
+        for i in 0..self.bodies.len() {
+            let mut s = self.bodies.sphere(i);
+            let (imp, hits) = fly(&mut s, self.size, target - self.bodies[i].t);
             c.wall_momentum += imp;
             c.wall_collisions += hits;
-            *b = Body::from_sphere(&s, target);
+            let b = &mut self.bodies[i];
+            (b.pos, b.vel, b.t) = (s.pos, s.vel, target);
         }
     }
 
     fn write_back(&mut self, world: &mut World) {
         let now = world.time - self.origin;
-        for (&k, b) in self.order.iter().zip(&mut self.bodies) {
+        for (&k, b) in self.order.iter().zip(self.bodies.iter_mut()) {
             b.advance(now);
             let s = &mut world.spheres[k as usize];
             s.pos = b.pos;
@@ -567,7 +547,7 @@ impl<Q: EventQueue + Send> Model for EventDriven<Q> {
                 self.sorted_at = moved;
             }
             if !self.valid {
-                for b in &mut self.bodies {
+                for b in self.bodies.iter_mut() {
                     b.advance(world.time - self.origin);
                 }
                 self.reschedule_all();

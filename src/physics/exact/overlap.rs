@@ -8,7 +8,7 @@
 //! cells, and a large sphere scans every cell it could reach; with
 //! neighbour lists, relists keep each sphere within the skin of its list
 //! centre, so two spheres that touch are listed.
-use super::body::Body;
+use super::body::Bodies;
 use super::queue::EventQueue;
 use super::{Broad, EventDriven};
 use crate::physics::exec::{Exec, for_each_block};
@@ -24,7 +24,7 @@ impl<Q: EventQueue> EventDriven<Q> {
     /// (0 if none), as `World::max_overlap_rel` gives it for the world the
     /// bodies were last written to (the max is order-free, so the same bits).
     pub(super) fn deepest_overlap(&self, exec: &dyn Exec) -> f64 {
-        let (bodies, broad) = (&self.bodies[..], &self.broad);
+        let (bodies, broad) = (&self.bodies, &self.broad);
         let worst = Mutex::new(0.0f64);
         let keep = |deepest: f64| {
             let mut w = worst.lock();
@@ -58,7 +58,7 @@ impl<Q: EventQueue> EventDriven<Q> {
                 let mut out = Vec::new();
                 for &i in cells.bigs() {
                     let i = i as usize;
-                    let k = cells.candidates(i, &bodies[i], &mut out);
+                    let k = cells.candidates(i, bodies.radius(i), &mut out);
                     keep(
                         out[..k]
                             .iter()
@@ -76,16 +76,17 @@ impl<Q: EventQueue> EventDriven<Q> {
 /// `worst`, or the overlap of bodies `i` and `j` relative to the smaller
 /// radius if deeper: the depth computed as `World::max_overlap_rel` does.
 #[inline]
-fn deeper(worst: f64, bodies: &[Body], i: usize, j: usize) -> f64 {
+fn deeper(worst: f64, bodies: &Bodies, i: usize, j: usize) -> f64 {
     let (a, b) = (&bodies[i], &bodies[j]);
-    let s = a.radius + b.radius;
+    let (ra, rb) = (bodies.radius_of(a), bodies.radius_of(b));
+    let s = ra + rb;
     // sqrt(fl(s * s)) == s, so a pair this skips has a depth of at most 0.
     if a.pos.distance_squared(b.pos) >= s * s {
         return worst;
     }
     let depth = s - a.pos.distance(b.pos);
     if depth > 0.0 {
-        worst.max(depth / a.radius.min(b.radius))
+        worst.max(depth / ra.min(rb))
     } else {
         worst
     }

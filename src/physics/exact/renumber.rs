@@ -115,10 +115,8 @@ impl<Q: EventQueue> EventDriven<Q> {
             .iter()
             .map(|&old| self.queue.time_of(old as usize))
             .collect();
-        apply(&mut self.bodies, &perm);
-        self.mass.relabel(&perm);
+        apply(self.bodies.list_mut(), &perm);
         apply(&mut self.order, &perm);
-        apply(&mut self.counts, &perm);
         apply(&mut self.slots, &perm);
         for slot in &mut self.slots {
             let mut ev = slot.ev;

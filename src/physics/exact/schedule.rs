@@ -4,7 +4,7 @@
 //! event is kept (one per sphere, as Smallenburg's EDMD does); a contact
 //! stays valid while the partner's collision count is unchanged, and is
 //! recomputed when it comes due otherwise.
-use super::body::Body;
+use super::body::{Bodies, Body};
 use crate::physics::contact::pair_toi;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -89,8 +89,9 @@ impl Slot {
 /// partners in the order offered.
 pub struct Predictor<'a> {
     a: Body,
-    bodies: &'a [Body],
-    counts: &'a [u32],
+    /// `a`'s radius.
+    ra: f64,
+    bodies: &'a Bodies,
     best: f64,
     /// `best`, finite (an infinite one times zero would be NaN and pass the
     /// cheap test); kept beside it so the test per candidate skips a `min`.
@@ -101,18 +102,12 @@ pub struct Predictor<'a> {
 impl<'a> Predictor<'a> {
     /// Start from the broad-phase event `(in_t, ev)` (relative time) and the walls.
     #[inline]
-    pub fn new(
-        a: &Body,
-        bodies: &'a [Body],
-        counts: &'a [u32],
-        size: f64,
-        in_t: f64,
-        ev: Event,
-    ) -> Self {
+    pub fn new(a: &Body, bodies: &'a Bodies, size: f64, in_t: f64, ev: Event) -> Self {
+        let ra = bodies.radius_of(a);
         let mut p = Predictor {
             a: *a,
+            ra,
             bodies,
-            counts,
             best: in_t,
             bound: in_t.min(f64::MAX),
             ev: if in_t.is_finite() {
@@ -121,7 +116,7 @@ impl<'a> Predictor<'a> {
                 Event::default()
             },
         };
-        let (tw, mask) = wall_toi(a, size);
+        let (tw, mask) = wall_toi(a, ra, size);
         if tw < p.best {
             p.best = tw;
             p.bound = tw.min(f64::MAX);
@@ -137,11 +132,11 @@ impl<'a> Predictor<'a> {
     /// Continue from an earlier prediction's best `(t, ev)` (relative time),
     /// which already weighed the walls: sphere `a` has not turned since.
     #[inline]
-    pub fn resume(a: &Body, bodies: &'a [Body], counts: &'a [u32], t: f64, ev: Event) -> Self {
+    pub fn resume(a: &Body, bodies: &'a Bodies, t: f64, ev: Event) -> Self {
         Predictor {
             a: *a,
+            ra: bodies.radius_of(a),
             bodies,
-            counts,
             best: t,
             bound: t.min(f64::MAX),
             ev,
@@ -156,7 +151,7 @@ impl<'a> Predictor<'a> {
         let dp = a.pos - b.pos_at(a.t);
         let dv = a.vel - b.vel;
         let bb = dp.dot(dv);
-        let sigma = a.radius + b.radius;
+        let sigma = self.ra + self.bodies.radius_of(b);
         let c = dp.length_squared() - sigma * sigma;
         // Only approaching pairs (bb < 0) can touch, and then the root is at
         // least c / (-2 bb): skip pairs that cannot beat `best` without a
@@ -182,7 +177,7 @@ impl<'a> Predictor<'a> {
             self.ev = Event {
                 kind: Kind::Pair,
                 partner: j,
-                partner_count: self.counts[j as usize],
+                partner_count: b.count,
                 ..Event::default()
             };
         }
@@ -200,13 +195,13 @@ impl<'a> Predictor<'a> {
 /// [`wall_toi`](crate::physics::contact::wall_toi), with selects instead of
 /// branches on the signs of the velocity.
 #[inline]
-pub fn wall_toi(a: &Body, size: f64) -> (f64, u8) {
+pub fn wall_toi(a: &Body, radius: f64, size: f64) -> (f64, u8) {
     let mut t = [f64::INFINITY; 3];
     for (k, tk) in t.iter_mut().enumerate() {
         let v = a.vel[k];
         // Indexing, not `if`: LLVM turns a select on the (random) sign back
         // into a branch, and that branch mispredicted half the time.
-        let gap = [size - a.radius - a.pos[k], a.pos[k] - a.radius][(v < 0.0) as usize];
+        let gap = [size - radius - a.pos[k], a.pos[k] - radius][(v < 0.0) as usize];
         let dt = (gap / v.abs()).max(0.0);
         *tk = [f64::INFINITY, dt][(v != 0.0) as usize];
     }

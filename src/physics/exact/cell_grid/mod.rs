@@ -13,7 +13,7 @@
 //! checks the large ones).
 pub mod blocks;
 
-use super::body::Body;
+use super::body::{Bodies, Body};
 use super::large::{BIG_FACTOR, split_big, time_to_leave};
 use super::renumber::apply;
 use super::schedule::{Event, Kind};
@@ -83,7 +83,7 @@ pub struct CellGrid {
 impl CellGrid {
     /// A grid of cells at least a diameter wide and at most `per_sphere`
     /// cells per sphere.
-    pub fn build(&mut self, bodies: &[Body], size: f64, per_sphere: u32) {
+    pub fn build(&mut self, bodies: &Bodies, size: f64, per_sphere: u32) {
         let n = bodies.len();
         self.list.reset(0, 0);
         self.place.clear();
@@ -109,7 +109,7 @@ impl CellGrid {
         self.set_stencils();
         self.list.reset(n, self.padded.pow(3));
         for (i, b) in bodies.iter().enumerate() {
-            if b.radius > big_above {
+            if bodies.radius_of(b) > big_above {
                 self.bigs.push(i as u32);
                 self.scan_centre.push(b.pos);
             } else {
@@ -266,10 +266,10 @@ impl CellGrid {
     /// them): the 27 cells around a small one, the cells over a large one's
     /// reach from its scan centre; and every large sphere.
     #[inline]
-    pub fn candidates(&self, i: usize, b: &Body, out: &mut Vec<u32>) -> usize {
+    pub fn candidates(&self, i: usize, radius: f64, out: &mut Vec<u32>) -> usize {
         let n = if self.is_big(i) {
             let centre = self.scan_centre[self.big_slot(i)];
-            let reach = DVec3::splat((b.radius + self.small_rmax + self.skin) * (1.0 + 1e-9));
+            let reach = DVec3::splat((radius + self.small_rmax + self.skin) * (1.0 + 1e-9));
             let (lo, hi) = (self.coords(centre - reach), self.coords(centre + reach));
             let cells: Vec<usize> = (lo[2]..=hi[2])
                 .flat_map(|z| {

@@ -17,7 +17,7 @@
 pub mod chains;
 
 use super::NONE;
-use super::body::Body;
+use super::body::{Bodies, Body};
 use super::large::{BIG_FACTOR, split_big, time_to_leave};
 use super::renumber::{apply, apply_chunks};
 use chains::CellChains;
@@ -218,12 +218,12 @@ impl NeighbourLists {
     }
 
     /// Lists for every sphere, all centred where the spheres are now.
-    pub fn build(&mut self, bodies: &[Body], size: f64) {
+    pub fn build(&mut self, bodies: &Bodies, size: f64) {
         let n = bodies.len();
         self.centre.clear();
         self.centre.extend(bodies.iter().map(|b| Centre {
             pos: b.pos,
-            radius: b.radius,
+            radius: bodies.radius_of(b),
         }));
         self.lists.reset(n);
         self.bigs.clear();
@@ -231,7 +231,7 @@ impl NeighbourLists {
         if n == 0 {
             return;
         }
-        let mut radii: Vec<f64> = bodies.iter().map(|b| b.radius).collect();
+        let mut radii: Vec<f64> = bodies.iter().map(|b| bodies.radius_of(b)).collect();
         let k = (n * 98 / 100).min(n - 1);
         let bulk = *radii.select_nth_unstable_by(k, f64::total_cmp).1;
         let big_above;
@@ -252,7 +252,7 @@ impl NeighbourLists {
         self.skin = (0.5 * size / self.per_side as f64 - self.small_rmax).max(skin);
         self.cells.reset(n, self.per_side.pow(3));
         for (i, b) in bodies.iter().enumerate() {
-            if b.radius > big_above {
+            if bodies.radius_of(b) > big_above {
                 self.bigs.push(i as u32);
                 self.lists.make_big(i);
             } else {
@@ -265,7 +265,7 @@ impl NeighbourLists {
     }
 
     /// Sphere `i` (moved to the current time) gets a new centre and list.
-    pub fn rebuild(&mut self, i: usize, bodies: &[Body]) {
+    pub fn rebuild(&mut self, i: usize, bodies: &Bodies) {
         self.lists.unlink_all(i);
         self.centre[i].pos = bodies[i].pos;
         if self.cells.cell(i) != NONE {
@@ -297,9 +297,9 @@ impl NeighbourLists {
     }
 
     /// Find the neighbours `j` of `i` (with `want(j)`) and link both ways.
-    fn scan(&mut self, i: usize, bodies: &[Body], want: impl Fn(usize) -> bool) {
+    fn scan(&mut self, i: usize, bodies: &Bodies, want: impl Fn(usize) -> bool) {
         let ci = self.centre[i].pos;
-        let ri = bodies[i].radius + 2.0 * self.skin;
+        let ri = bodies.radius(i) + 2.0 * self.skin;
         let test = |j: usize, centre: &[Centre], lists: &mut Lists| {
             if !want(j) {
                 return;
@@ -311,7 +311,7 @@ impl NeighbourLists {
             }
         };
         let reach = if self.cells.cell(i) == NONE {
-            bodies[i].radius + self.small_rmax + 2.0 * self.skin
+            bodies.radius(i) + self.small_rmax + 2.0 * self.skin
         } else {
             0.0
         };
