@@ -1,8 +1,10 @@
 use glam::DVec3;
 
-/// A frictionless hard sphere. 64 bytes: one cache line, so the hot loops touch
-/// one line per sphere.
+/// A frictionless hard sphere. 64 bytes, aligned to a cache line, so the hot
+/// loops touch one line per sphere (only 8-aligned, a `Vec` of them from
+/// `malloc` put every sphere across two lines).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(64))]
 pub struct Sphere {
     pub pos: DVec3,
     pub vel: DVec3,
