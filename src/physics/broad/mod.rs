@@ -59,13 +59,13 @@ pub struct Grid {
 }
 
 /// The first level's records as cell keys and the spheres they come from.
-struct Keyed<'a, B> {
+struct Keyed<'a, T, B> {
     keys: &'a [u32],
-    spheres: &'a [Sphere],
+    spheres: &'a [T],
     ball: &'a B,
 }
 
-impl<B: Fn(&Sphere) -> (DVec3, f64) + Sync> Source for Keyed<'_, B> {
+impl<T: Sync, B: Fn(&T) -> (DVec3, f64) + Sync> Source for Keyed<'_, T, B> {
     #[inline(always)]
     fn keys(&self) -> impl DoubleEndedIterator<Item = (u32, f64)> + ExactSizeIterator {
         self.keys.iter().map(|&k| (k, 0.0))
@@ -126,15 +126,16 @@ enum Unit {
 }
 
 impl Grid {
-    /// Bin the spheres. `ball(s)` is a centre and a reach: during the step
+    /// Bin the spheres (or any items with a ball). `ball(s)` is a centre and
+    /// a reach: during the step
     /// the sphere stays inside that ball, so a pair matters only when the
     /// distance of the centres is at most the sum of the reaches. The
     /// per-sphere arithmetic of the first level runs on `exec`.
-    pub fn build(
+    pub fn build<T: Sync>(
         &mut self,
-        spheres: &[Sphere],
+        spheres: &[T],
         size: f64,
-        ball: impl Fn(&Sphere) -> (DVec3, f64) + Sync,
+        ball: impl Fn(&T) -> (DVec3, f64) + Sync,
         exec: &dyn Exec,
     ) {
         let n = spheres.len();
@@ -254,10 +255,10 @@ impl Grid {
     /// each sphere's cell key is staged (and the widest ball kept) in
     /// parallel blocks, then the level sorts the spheres by key and makes
     /// each record again where it goes. The same level as from records.
-    fn build_keyed(
+    fn build_keyed<T: Sync>(
         &mut self,
-        spheres: &[Sphere],
-        ball: &(impl Fn(&Sphere) -> (DVec3, f64) + Sync),
+        spheres: &[T],
+        ball: &(impl Fn(&T) -> (DVec3, f64) + Sync),
         exec: &dyn Exec,
     ) {
         let n = spheres.len();

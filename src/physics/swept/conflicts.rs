@@ -132,8 +132,9 @@ pub(super) struct Conflicts {
     /// run: their paths are compared once the runs agree.
     pub cross: Vec<(u32, u32)>,
     /// Scratch of the grown-ball check: every slot's ball, a grid over
-    /// them, the pairs it found, each slot's cluster.
-    balls: Vec<Sphere>,
+    /// them, the pairs it found, each slot's cluster. A ball is its
+    /// centre and reach (32 bytes; a whole `Sphere` was 64).
+    balls: Vec<(DVec3, f64)>,
     overlap: Grid,
     overlap_pairs: Vec<(u32, u32)>,
     cluster_of: Vec<Slot>,
@@ -192,18 +193,12 @@ impl Conflicts {
         // Every slot's ball, indexed by slot.
         self.balls.clear();
         for s in 0..m {
-            let (centre, reach) = fin.ball(s, part.ids[s], spheres, dt);
-            self.balls.push(Sphere {
-                pos: centre,
-                vel: DVec3::ZERO,
-                radius: reach,
-                mass: 0.0,
-            });
+            self.balls.push(fin.ball(s, part.ids[s], spheres, dt));
         }
         self.overlap.build(
             &self.balls,
             size,
-            |b| (b.pos, b.radius),
+            |&ball| ball,
             small(exec, self.balls.len()),
         );
         let mut pairs = std::mem::take(&mut self.overlap_pairs);
