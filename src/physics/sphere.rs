@@ -31,3 +31,13 @@ impl Sphere {
 pub fn volume(radius: f64) -> f64 {
     4.0 / 3.0 * std::f64::consts::PI * radius * radius * radius
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_sphere_is_one_cache_line() {
+        assert_eq!((size_of::<Sphere>(), align_of::<Sphere>()), (64, 64));
+    }
+}
