@@ -355,9 +355,7 @@ fn the_cell_grid_and_the_event_slots_stay_small() {
 /// array per sphere would pass 140.
 #[test]
 fn the_model_holds_under_140_bytes_a_sphere_at_100k() {
-    use ballpit::physics::exact::body::Body;
     use ballpit::scene::{SceneSpec, build_world};
-    assert_eq!((size_of::<Body>(), align_of::<Body>()), (64, 64));
     for radius in [0.002_285_39, 0.006_19] {
         let mut w = build_world(&SceneSpec {
             count: Some(100_000),

@@ -264,7 +264,8 @@ impl CellGrid {
     /// Every sphere that sphere `i` could touch before its next broad-phase
     /// event, into `out[..n]` (returns `n`; sphere `i` itself may be among
     /// them): the 27 cells around a small one, the cells over a large one's
-    /// reach from its scan centre; and every large sphere.
+    /// reach (its `radius` plus the bulk's and a skin) from its scan centre;
+    /// and every large sphere.
     #[inline]
     pub fn candidates(&self, i: usize, radius: f64, out: &mut Vec<u32>) -> usize {
         let n = if self.is_big(i) {
