@@ -12,11 +12,13 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 #![allow(clippy::unreadable_literal)] // pinned hashes, as the failure prints them
 use ballpit::physics::exact::Exact;
-use ballpit::physics::{Model, Serial, Sphere, World};
+use ballpit::physics::{Model, Serial, World};
 use ballpit::scene::lattice::lattice_world;
 use ballpit::scene::{SceneSpec, build_world};
-use glam::DVec3;
 use std::sync::{Arc, Mutex};
+#[path = "common/large.rs"]
+mod large;
+use large::with_three_large;
 
 /// FNV-1a over 64-bit words.
 #[derive(Clone, Copy)]
@@ -113,18 +115,9 @@ fn moderate_gas_is_bit_identical() {
 /// A gas with three spheres 15x larger: those on the second level of the cells.
 #[test]
 fn large_spheres_among_small_are_bit_identical() {
-    let gas = scene("gas", 4000, Some(0.005), 5);
-    let big = [[0.25, 0.3, 0.4], [0.7, 0.6, 0.5], [0.4, 0.75, 0.7]]
-        .map(|p| Sphere::new(DVec3::from(p), DVec3::new(0.3, -0.2, 0.1), 0.075));
-    let clear = |s: &Sphere| {
-        big.iter()
-            .all(|b| s.pos.distance(b.pos) > s.radius + b.radius)
-    };
-    let mut spheres: Vec<Sphere> = gas.spheres.into_iter().filter(clear).collect();
-    spheres.extend(big);
     pin(
         "large",
-        World::new(1.0, spheres),
+        with_three_large(scene("gas", 4000, Some(0.005), 5)),
         1.0 / 60.0,
         200,
         (0x36548472e8f769ba, 6256),

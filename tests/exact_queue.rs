@@ -5,11 +5,14 @@
 //! same contacts and final state, bit for bit, on a few scenes.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use ballpit::physics::exact::{Calendar, Contact, EventDriven, EventQueue, Tournament};
-use ballpit::physics::{Model, Serial, Sphere, World};
+use ballpit::physics::{Model, Serial, World};
 use ballpit::scene::lattice::lattice_world;
 use ballpit::scene::{SceneSpec, build_world};
 use glam::DVec3;
 use proptest::prelude::*;
+#[path = "common/large.rs"]
+mod large;
+use large::with_three_large;
 use std::sync::{Arc, Mutex};
 
 #[derive(Clone, Debug)]
@@ -310,14 +313,5 @@ fn dense_runs_alike() {
 /// Mixed radii: three spheres 15x the bulk (the second level).
 #[test]
 fn mixed_radii_run_alike() {
-    let gas = gas(3000, 0.005);
-    let big = [[0.25, 0.3, 0.4], [0.7, 0.6, 0.5], [0.4, 0.75, 0.7]]
-        .map(|p| Sphere::new(DVec3::from(p), DVec3::new(0.3, -0.2, 0.1), 0.075));
-    let clear = |s: &Sphere| {
-        big.iter()
-            .all(|b| s.pos.distance(b.pos) > s.radius + b.radius)
-    };
-    let mut spheres: Vec<Sphere> = gas.spheres.into_iter().filter(clear).collect();
-    spheres.extend(big);
-    alike("mixed", World::new(1.0, spheres), 1.0 / 30.0, 40);
+    alike("mixed", with_three_large(gas(3000, 0.005)), 1.0 / 30.0, 40);
 }
