@@ -306,7 +306,7 @@ impl<Q: EventQueue> EventDriven<Q> {
             Broad::Cells(cells) => {
                 let idle = Event::default();
                 let mut p = Predictor::new(a, &self.bodies, self.size, f64::INFINITY, idle);
-                let n = cells.candidates(i, self.bodies.radius_of(a), &mut self.candidates);
+                let n = cells.candidates(i, p.radius(), &mut self.candidates);
                 for &j in &self.candidates[..n] {
                     if j as usize != i {
                         p.pair(j);

@@ -143,6 +143,12 @@ impl<'a> Predictor<'a> {
         }
     }
 
+    /// Sphere `a`'s radius.
+    #[inline(always)]
+    pub fn radius(&self) -> f64 {
+        self.ra
+    }
+
     /// Consider a contact with sphere `j`.
     #[inline(always)]
     pub fn pair(&mut self, j: u32) {
