@@ -4,12 +4,12 @@
 use crossbeam_channel::Sender;
 use crossterm::event::KeyEvent;
 use crossterm::{cursor, execute, queue, terminal};
-use parking_lot::Mutex;
+use parking_lot::{Condvar, Mutex};
 use std::io::{self, Write};
 use std::sync::OnceLock;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 use std::thread;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 /// What wakes the frame loop besides its own clock.
 #[derive(Clone, Debug, PartialEq)]
@@ -22,44 +22,132 @@ pub enum Msg {
     /// The physics finished a frame.
     PhysicsDone,
     Resize,
-    /// A termination signal (its number).
+    /// A termination signal (its number): the `signals` thread is ending
+    /// the process.
     Signal(i32),
+    /// The process is being stopped (job control): the terminal is the
+    /// shell's until `Resumed`.
+    Held,
+    /// Back in the foreground after a stop: everything must be repainted.
+    Resumed,
     /// The terminal is gone or unreadable.
     Fatal(String),
     /// Some thread panicked (the hook has restored the terminal already).
     Panic,
 }
 
-/// The terminal's state: set up or restored, and the lock every write to it
-/// holds, so that nothing is written once `restore` has run.
+/// The terminal's state: set up, held (the process is suspended: frames are
+/// dropped, the screen is repainted on resume) or restored, and the lock
+/// every write to it holds, so that nothing is written once `restore` has
+/// run.
 pub struct Latch {
-    active: AtomicBool,
+    state: AtomicU8,
+    /// Held through every change of state, so a second `close` returns only
+    /// once the terminal is really back.
+    changing: Mutex<()>,
     writing: Mutex<()>,
+    /// Status requests written and not yet answered.
+    owed: Mutex<u64>,
+    answered: Condvar,
 }
+
+const OFF: u8 = 0;
+const ON: u8 = 1;
+const HELD: u8 = 2;
 
 /// How long `restore` waits for a write in progress (a frame going out over
 /// a slow link) before it writes anyway.
 const RESTORE_WAIT: Duration = Duration::from_millis(500);
 
+/// How long a restore waits for the answers to status requests still in
+/// flight: read by the app, they do not land in the shell's input.
+pub const DRAIN_WAIT: Duration = Duration::from_millis(200);
+
 impl Latch {
     pub const fn new() -> Latch {
         Latch {
-            active: AtomicBool::new(false),
+            state: AtomicU8::new(OFF),
+            changing: Mutex::new(()),
             writing: Mutex::new(()),
+            owed: Mutex::new(0),
+            answered: Condvar::new(),
         }
     }
 
     fn open(&self) {
-        self.active.store(true, Ordering::SeqCst);
+        self.state.store(ON, Ordering::SeqCst);
     }
 
     /// Closes the latch; `put_back` runs once, after any write in progress
-    /// has finished. Later writes through a [`Gated`] writer fail.
+    /// has finished and the answers owed have been read (or `DRAIN_WAIT`
+    /// has passed). Later writes through a [`Gated`] writer fail.
     pub fn close(&self, put_back: impl FnOnce()) {
-        if self.active.swap(false, Ordering::SeqCst) {
+        let _changing = self.changing.lock();
+        if self.state.swap(OFF, Ordering::SeqCst) == ON {
             let _lock = self.writing.try_lock_for(RESTORE_WAIT);
+            self.drain(DRAIN_WAIT);
             put_back();
         }
+    }
+
+    /// Like `close`, but later writes are dropped instead of refused, until
+    /// `reopen`. Returns whether the terminal was set up.
+    pub fn hold(&self, put_back: impl FnOnce()) -> bool {
+        let _changing = self.changing.lock();
+        if self
+            .state
+            .compare_exchange(ON, HELD, Ordering::SeqCst, Ordering::SeqCst)
+            .is_err()
+        {
+            return false;
+        }
+        let _lock = self.writing.try_lock_for(RESTORE_WAIT);
+        self.drain(DRAIN_WAIT);
+        put_back();
+        true
+    }
+
+    /// After a `hold` (or a stop the app did not see): `set_up` runs with
+    /// writes locked out, then writes go through again. Nothing happens once
+    /// the latch is closed for good.
+    pub fn reopen(&self, set_up: impl FnOnce()) -> bool {
+        let _changing = self.changing.lock();
+        let _lock = self.writing.try_lock_for(RESTORE_WAIT);
+        if self.state.load(Ordering::SeqCst) == OFF {
+            return false;
+        }
+        // Answers lost with the old terminal state are not waited for.
+        *self.owed.lock() = 0;
+        set_up();
+        self.state.store(ON, Ordering::SeqCst);
+        true
+    }
+
+    /// The input thread read an answer to a status request.
+    pub fn answer(&self) {
+        let mut owed = self.owed.lock();
+        *owed = owed.saturating_sub(1);
+        if *owed == 0 {
+            self.answered.notify_all();
+        }
+    }
+
+    /// Status requests not answered yet.
+    pub fn owed(&self) -> u64 {
+        *self.owed.lock()
+    }
+
+    /// Wait until every status request written has been answered, at most
+    /// `limit`. Returns whether all were.
+    pub fn drain(&self, limit: Duration) -> bool {
+        let end = Instant::now() + limit;
+        let mut owed = self.owed.lock();
+        while *owed > 0 {
+            if self.answered.wait_until(&mut owed, end).timed_out() {
+                return *owed == 0;
+            }
+        }
+        true
     }
 }
 
@@ -86,20 +174,41 @@ fn restored() -> io::Error {
     io::Error::other("the terminal has been restored")
 }
 
+impl<W: Write> Gated<W> {
+    /// Write `chunk` whole, which asks `queries` status requests: they are
+    /// owed answers only if the chunk really goes out. While the terminal
+    /// is held the chunk is dropped.
+    pub fn write_chunk(&mut self, chunk: &[u8], queries: u64) -> io::Result<()> {
+        let _lock = self.latch.writing.lock();
+        match self.latch.state.load(Ordering::SeqCst) {
+            ON => {
+                // Counted first: a write cut short may still have sent them.
+                *self.latch.owed.lock() += queries;
+                self.inner.write_all(chunk)?;
+                self.inner.flush()
+            }
+            HELD => Ok(()),
+            _ => Err(restored()),
+        }
+    }
+}
+
 impl<W: Write> Write for Gated<W> {
     fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
         let _lock = self.latch.writing.lock();
-        if !self.latch.active.load(Ordering::SeqCst) {
-            return Err(restored());
+        match self.latch.state.load(Ordering::SeqCst) {
+            ON => self.inner.write(buf),
+            HELD => Ok(buf.len()),
+            _ => Err(restored()),
         }
-        self.inner.write(buf)
     }
     fn flush(&mut self) -> io::Result<()> {
         let _lock = self.latch.writing.lock();
-        if !self.latch.active.load(Ordering::SeqCst) {
-            return Err(restored());
+        match self.latch.state.load(Ordering::SeqCst) {
+            ON => self.inner.flush(),
+            HELD => Ok(()),
+            _ => Err(restored()),
         }
-        self.inner.flush()
     }
 }
 
@@ -141,10 +250,7 @@ impl Guard {
         TERMINAL.open();
         // Made before the next step, so a failure there is undone too.
         let guard = Guard(());
-        let mut out = io::stdout();
-        execute!(out, terminal::EnterAlternateScreen, cursor::Hide)?;
-        out.write_all(PASTE_ON)?;
-        out.flush()?;
+        set_up_screen()?;
         Ok(guard)
     }
 }
@@ -155,61 +261,81 @@ impl Drop for Guard {
     }
 }
 
+/// Alternate screen, hidden cursor, bracketed paste.
+fn set_up_screen() -> io::Result<()> {
+    let mut out = io::stdout();
+    execute!(out, terminal::EnterAlternateScreen, cursor::Hide)?;
+    out.write_all(PASTE_ON)?;
+    out.flush()
+}
+
+/// The terminal as the shell had it. Errors are ignored: the terminal may
+/// already be gone.
+fn put_back() {
+    let mut out = io::stdout();
+    let _ = queue!(out, terminal::EndSynchronizedUpdate);
+    let _ = out.write_all(b"\x1b[0m");
+    let _ = out.write_all(PASTE_OFF);
+    let _ = execute!(out, cursor::Show, terminal::LeaveAlternateScreen);
+    let _ = out.flush();
+    let _ = terminal::disable_raw_mode();
+}
+
 /// Whether a panic happened anywhere since start.
 pub fn panicked() -> bool {
     PANICKED.load(Ordering::SeqCst)
 }
 
-/// Put the terminal back; safe to call more than once and from any thread.
-/// Errors are ignored: the terminal may already be gone.
+/// Put the terminal back for good; safe to call more than once and from
+/// any thread. The status requests still in flight are answered and read
+/// first (at most [`DRAIN_WAIT`]), so their answers do not reach the shell.
 pub fn restore() {
-    TERMINAL.close(|| {
-        let mut out = io::stdout();
-        let _ = queue!(out, terminal::EndSynchronizedUpdate);
-        let _ = out.write_all(b"\x1b[0m");
-        let _ = out.write_all(PASTE_OFF);
-        let _ = execute!(out, cursor::Show, terminal::LeaveAlternateScreen);
-        let _ = out.flush();
-        let _ = terminal::disable_raw_mode();
-    });
+    TERMINAL.close(put_back);
 }
 
-/// How long the frame loop gets to exit by itself after a termination
-/// signal or a quit key before the process is ended for it (the loop may be
-/// waiting on a long physics frame, which cannot be interrupted).
+/// Give the terminal back before the process stops (job control); frames
+/// drawn meanwhile are dropped. Returns whether it was set up.
+pub fn suspend() -> bool {
+    TERMINAL.hold(put_back)
+}
+
+/// After a stop: raw mode, the alternate screen and the hidden cursor
+/// again, even if the app did not see the stop (SIGSTOP) and the shell
+/// reset the terminal meanwhile. Returns whether the screen is the app's.
+pub fn resume() -> bool {
+    TERMINAL.reopen(|| {
+        // crossterm skips enabling raw mode it believes is on: off, then
+        // on, sets it whatever the shell did.
+        let _ = terminal::disable_raw_mode();
+        let _ = terminal::enable_raw_mode();
+        let _ = set_up_screen();
+    })
+}
+
+/// How long the frame loop gets to exit by itself after a quit key before
+/// the process is ended for it (the loop may be waiting on a long physics
+/// frame, which cannot be interrupted).
 pub const QUIT_GRACE: Duration = Duration::from_millis(700);
 
 /// Give the frame loop `QUIT_GRACE` to finish, then restore the terminal
-/// and end the process with `code`. Called on the thread that saw the
-/// request, which has nothing else left to do.
-pub fn end_after_grace(code: i32) -> ! {
-    thread::sleep(QUIT_GRACE);
-    restore();
-    std::process::exit(code);
-}
-
-/// A named thread turning signals into messages. Returns a handle whose
-/// `close` stops it.
-pub fn spawn_signals(tx: Sender<Msg>) -> io::Result<signal_hook::iterator::Handle> {
-    use signal_hook::consts::{SIGHUP, SIGINT, SIGQUIT, SIGTERM, SIGWINCH};
-    let mut signals =
-        signal_hook::iterator::Signals::new([SIGTERM, SIGHUP, SIGINT, SIGQUIT, SIGWINCH])?;
-    let handle = signals.handle();
-    thread::Builder::new()
-        .name("signals".into())
+/// and end the process with `code`. On a thread of its own, so the input
+/// thread goes on reading the answers the restore waits for.
+pub fn end_after_grace(code: i32) {
+    static STARTED: AtomicBool = AtomicBool::new(false);
+    if STARTED.swap(true, Ordering::SeqCst) {
+        return;
+    }
+    let spawned = thread::Builder::new()
+        .name("quit-timer".into())
         .spawn(move || {
-            for sig in signals.forever() {
-                if sig == SIGWINCH {
-                    if tx.send(Msg::Resize).is_err() {
-                        return;
-                    }
-                    continue;
-                }
-                let _ = tx.send(Msg::Signal(sig));
-                end_after_grace(128 + sig);
-            }
-        })?;
-    Ok(handle)
+            thread::sleep(QUIT_GRACE);
+            restore();
+            std::process::exit(code);
+        });
+    if spawned.is_err() {
+        // No thread for the timer: the frame loop's own exit must do.
+        STARTED.store(false, Ordering::SeqCst);
+    }
 }
 
 #[cfg(test)]

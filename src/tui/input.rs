@@ -32,6 +32,8 @@ pub enum Action {
     FasterFps,
     /// Swap the canvas for the chart of per-thread CPU, and back.
     Chart,
+    /// Ctrl-Z: give the terminal back and stop (the input thread acts on it).
+    Suspend,
 }
 
 /// The key a press means, if any (releases are ignored). The keys are in

@@ -18,6 +18,7 @@ pub mod projection;
 pub mod reader;
 pub mod readouts;
 pub mod run;
+pub mod signals;
 pub mod state;
 pub mod term_input;
 pub mod theme;

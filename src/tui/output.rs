@@ -45,6 +45,10 @@ impl<W: Write> Write for Counting<W> {
 /// every frame. Everything but `draw` is crossterm's.
 pub struct Lean<W: Write> {
     inner: CrosstermBackend<W>,
+    /// Where the cursor was last put: ratatui asks for it on a clear, and
+    /// asking the terminal is a round trip whose answer the input thread
+    /// would take.
+    cursor: Position,
     /// What the terminal's SGR state is known to be.
     fg: Color,
     bg: Color,
@@ -55,6 +59,7 @@ impl<W: Write> Lean<W> {
     pub fn new(writer: W) -> Lean<W> {
         Lean {
             inner: CrosstermBackend::new(writer),
+            cursor: Position::ORIGIN,
             fg: Color::Reset,
             bg: Color::Reset,
             modifier: Modifier::empty(),
@@ -191,10 +196,11 @@ impl<W: Write> Backend for Lean<W> {
         self.inner.show_cursor()
     }
     fn get_cursor_position(&mut self) -> io::Result<Position> {
-        self.inner.get_cursor_position()
+        Ok(self.cursor)
     }
     fn set_cursor_position<P: Into<Position>>(&mut self, position: P) -> io::Result<()> {
-        self.inner.set_cursor_position(position)
+        self.cursor = position.into();
+        self.inner.set_cursor_position(self.cursor)
     }
     fn clear(&mut self) -> io::Result<()> {
         self.reset_sgr()?;

@@ -4,7 +4,9 @@
 //! resize cannot be lost (resizes come from the `signals` thread). End of
 //! input, hang-up and read errors mean the terminal is gone: the thread says
 //! so and stops, without spinning.
-use super::guard::Msg;
+use super::guard::{self, Msg};
+use super::input::Action;
+use super::signals;
 use super::term_input::{Input, Parser};
 use crossbeam_channel::Sender;
 use rustix::event::{PollFd, PollFlags, Timespec};
@@ -65,11 +67,22 @@ fn read_loop(tx: &Sender<Msg>) -> Option<String> {
         for ev in events.drain(..) {
             let msg = match ev {
                 Input::Key(k) => {
-                    quit |= super::input::action(k) == Some(super::input::Action::Quit);
+                    match super::input::action(k) {
+                        Some(Action::Quit) => quit = true,
+                        Some(Action::Suspend) => {
+                            signals::request_suspend();
+                            continue;
+                        }
+                        _ => {}
+                    }
                     Msg::Key(k)
                 }
-                // The pacing's answers: when they were read.
-                Input::StatusOk => Msg::Status(Instant::now()),
+                // The pacing's answers: when they were read. A restore
+                // waits for the ones still owed.
+                Input::StatusOk => {
+                    guard::TERMINAL.answer();
+                    Msg::Status(Instant::now())
+                }
                 // Pastes, focus changes and cursor reports are not commands.
                 Input::Cursor(..) | Input::Focus(_) | Input::Paste(_) => continue,
             };
@@ -79,8 +92,9 @@ fn read_loop(tx: &Sender<Msg>) -> Option<String> {
         }
         if quit {
             // `q` and Ctrl-C end the app within a second even while a long
-            // physics frame holds the frame loop.
-            super::guard::end_after_grace(0);
+            // physics frame holds the frame loop; this thread goes on
+            // reading the answers the restore waits for.
+            guard::end_after_grace(0);
         }
     }
 }

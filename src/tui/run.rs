@@ -8,7 +8,7 @@ use super::readouts::Stats;
 use super::state::AppState;
 use super::theme::Palette;
 use super::writer::Output;
-use super::{MAX_FPS, Options, input, reader};
+use super::{MAX_FPS, Options, input, reader, signals};
 use crate::cpu::{CpuReport, Sampler};
 use crate::engine::{Command, Engine, Rebuild, Settings, Snapshot};
 use crate::error::BadInput;
@@ -97,7 +97,7 @@ pub fn run_with(
         let _ = done.send(Msg::PhysicsDone);
     }));
     let guard = Guard::enter(tx.clone()).context("cannot set up the terminal")?;
-    let signals = guard::spawn_signals(tx.clone())?;
+    let signals = signals::spawn(tx.clone())?;
     reader::spawn_input(tx.clone())?;
     let mut result = FrameLoop::new(engine, state, palette, detected, tx).and_then(|mut l| {
         l.after_first_frame = after_first_frame;
@@ -107,6 +107,11 @@ pub fn run_with(
     // write first: the panic is the reason to report.
     if result.is_err() && guard::panicked() {
         result = Err(anyhow!("a thread panicked (message above)"));
+    }
+    if let Some(sig) = signals::ending() {
+        // The `signals` thread is ending the process by this signal: end
+        // it the same way, never first with another status.
+        signals::end_by(sig);
     }
     signals.close();
     drop(guard);
@@ -148,6 +153,10 @@ struct FrameLoop {
     dirty: bool,
     window: Window,
     after_first_frame: Option<AfterFirstFrame>,
+    /// Stopped by job control: no physics, no frames, until resumed.
+    held: bool,
+    /// The frame in flight spanned a stop: its physics time is not load.
+    stopped_mid_frame: bool,
 }
 
 /// Counts over the current one-second window for the per-second figures.
@@ -173,7 +182,7 @@ impl FrameLoop {
     ) -> anyhow::Result<FrameLoop> {
         let output = Output::spawn(events)?;
         // The start-up probe: does the terminal answer status requests?
-        output.send(pacing::QUERY.to_vec());
+        output.send(pacing::QUERY.to_vec(), 1);
         let pacer = Pacer::new(Instant::now());
         let sink = Sink::default();
         let (writer, bytes) = Counting::new(sink.clone());
@@ -215,6 +224,8 @@ impl FrameLoop {
                 ..Window::default()
             },
             after_first_frame: None,
+            held: false,
+            stopped_mid_frame: false,
         })
     }
 
@@ -222,14 +233,15 @@ impl FrameLoop {
         let mut next_frame = Instant::now();
         let mut next_sample = Instant::now() + SAMPLE_PERIOD;
         loop {
-            let wants_frame =
-                self.state.running() || self.pending || self.dirty || self.in_flight.is_some();
+            let wants_frame = !self.held
+                && (self.state.running() || self.pending || self.dirty || self.in_flight.is_some());
             let mut deadline = if wants_frame {
                 next_frame.min(next_sample)
             } else {
                 next_sample
             };
             if (self.dirty || self.update_wanted)
+                && !self.held
                 && let Some(t) = self.pacer.next_change()
             {
                 deadline = deadline.min(t);
@@ -252,6 +264,13 @@ impl FrameLoop {
             }
             let now = Instant::now();
             self.pacer.tick(now);
+            if self.held {
+                // Nothing runs while the shell has the terminal; the
+                // figures start afresh on resume.
+                next_sample = now + SAMPLE_PERIOD;
+                next_frame = now;
+                continue;
+            }
             if now >= next_sample {
                 self.sample(now);
                 next_sample = later(next_sample, SAMPLE_PERIOD, now);
@@ -307,7 +326,16 @@ impl FrameLoop {
                 self.dirty = true;
                 Ok(true)
             }
-            Msg::Signal(sig) => Err(anyhow!("stopped by {}", signal_name(sig))),
+            Msg::Signal(sig) => Err(anyhow!("stopped by {}", signals::name(sig))),
+            Msg::Held => {
+                self.held = true;
+                self.stopped_mid_frame |= self.in_flight.is_some();
+                Ok(false)
+            }
+            Msg::Resumed => {
+                self.resume()?;
+                Ok(true)
+            }
             Msg::Fatal(why) => Err(anyhow!(why)),
             Msg::Panic => Err(anyhow!("a thread panicked (message above)")),
         }
@@ -328,8 +356,10 @@ impl FrameLoop {
         if let Some(applied) = self.in_flight.take() {
             let snap = self.engine.finish_frame()?;
             self.window.steps += snap.steps;
-            self.window.physics_frames += 1;
-            self.window.physics_seconds += snap.physics_seconds;
+            if !std::mem::take(&mut self.stopped_mid_frame) {
+                self.window.physics_frames += 1;
+                self.window.physics_seconds += snap.physics_seconds;
+            }
             self.state.sync(snap, applied);
             self.dirty = true;
         }
@@ -405,7 +435,7 @@ impl FrameLoop {
         };
         let len = chunk.len();
         // A write error comes back from the output thread as Msg::Fatal.
-        if !self.output.send(chunk) {
+        if !self.output.send(chunk, if asked { 2 } else { 0 }) {
             return Err(anyhow!("the output thread stopped"));
         }
         self.pacer.sent(Instant::now(), len, asked);
@@ -419,6 +449,31 @@ impl FrameLoop {
             self.dirty = false;
         }
         self.update_wanted = false;
+        Ok(())
+    }
+
+    /// Back from a stop: a new terminal state (ask again whether it
+    /// answers), the whole screen repainted at its current size, and
+    /// figures that do not count the stop.
+    fn resume(&mut self) -> anyhow::Result<()> {
+        self.held = false;
+        let now = Instant::now();
+        self.pacer = Pacer::new(now);
+        self.output.send(pacing::QUERY.to_vec(), 1);
+        self.aspect = cell_aspect();
+        self.terminal.autoresize()?;
+        // Forgets what is on screen, so the next frame draws every cell.
+        self.terminal.clear()?;
+        self.drawn = None;
+        self.dirty = true;
+        // A sample now: the next readout spans only the time since, not
+        // the stop (the report on screen stays the one before it).
+        let _ = self.sampler.sample();
+        self.window = Window {
+            start: Some(now),
+            collisions_at_start: collisions(self.engine.snapshot()),
+            ..Window::default()
+        };
         Ok(())
     }
 
@@ -474,16 +529,5 @@ fn cell_aspect() -> f64 {
             (ch / cw).clamp(1.0, 3.0)
         }
         _ => 2.0,
-    }
-}
-
-fn signal_name(sig: i32) -> String {
-    use signal_hook::consts::{SIGHUP, SIGINT, SIGQUIT, SIGTERM};
-    match sig {
-        SIGHUP => "SIGHUP (the terminal hung up)".into(),
-        SIGINT => "SIGINT".into(),
-        SIGQUIT => "SIGQUIT".into(),
-        SIGTERM => "SIGTERM".into(),
-        n => format!("signal {n}"),
     }
 }

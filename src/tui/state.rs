@@ -195,6 +195,7 @@ impl AppState {
             Action::Chart => self.chart = !self.chart,
             Action::Reset => out.push(Command::Reset),
             Action::Help => self.help = !self.help,
+            Action::Suspend => {} // the input thread stops the process
             Action::SlowerFps => match FPS_STEPS.iter().rev().find(|&&f| f < self.fps - 1e-9) {
                 Some(&f) => self.fps = f,
                 None => self.notice = Some(format!("fps limit: {}", FPS_STEPS[0])),

@@ -4,25 +4,25 @@
 //! latch ([`guard::gated_stdout`]), so nothing lands after a restore.
 use super::guard::{self, Msg};
 use crossbeam_channel::Sender;
-use std::io::{self, Write};
+use std::io;
 use std::thread;
 
 /// Where frames go: a channel to the `output` thread.
 pub struct Output {
-    tx: Sender<Vec<u8>>,
+    tx: Sender<(Vec<u8>, u64)>,
 }
 
 impl Output {
     /// Start the thread; it reports each chunk written (or the error that
     /// ended it) on `events`.
     pub fn spawn(events: Sender<Msg>) -> io::Result<Output> {
-        let (tx, rx) = crossbeam_channel::unbounded::<Vec<u8>>();
+        let (tx, rx) = crossbeam_channel::unbounded::<(Vec<u8>, u64)>();
         thread::Builder::new()
             .name("output".into())
             .spawn(move || {
                 let mut out = guard::gated_stdout();
-                for chunk in rx {
-                    let msg = match out.write_all(&chunk).and_then(|()| out.flush()) {
+                for (chunk, queries) in rx {
+                    let msg = match out.write_chunk(&chunk, queries) {
                         Ok(()) => Msg::Written,
                         Err(e) => Msg::Fatal(format!("writing to the terminal failed: {e}")),
                     };
@@ -35,8 +35,10 @@ impl Output {
         Ok(Output { tx })
     }
 
-    /// Queue `bytes`; false if the thread has stopped.
-    pub fn send(&self, bytes: Vec<u8>) -> bool {
-        self.tx.send(bytes).is_ok()
+    /// Queue `bytes`, which ask `queries` status requests (the terminal owes
+    /// that many answers once they are written); false if the thread has
+    /// stopped.
+    pub fn send(&self, bytes: Vec<u8>, queries: u64) -> bool {
+        self.tx.send((bytes, queries)).is_ok()
     }
 }

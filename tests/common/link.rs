@@ -208,6 +208,17 @@ impl Link {
         self.screen.lock().unwrap().screen().contents()
     }
 
+    /// Whether the alternate screen is on, and whether the cursor is hidden.
+    pub fn modes(&self) -> (bool, bool) {
+        let p = self.screen.lock().unwrap();
+        (p.screen().alternate_screen(), p.screen().hide_cursor())
+    }
+
+    /// Blank the screen model (what comes next must draw it again).
+    pub fn blank(&self) {
+        self.screen.lock().unwrap().process(b"\x1b[2J");
+    }
+
     /// When `pred` first held for the screen (polled every millisecond),
     /// or None at the deadline.
     pub fn wait_for(&self, secs: f64, pred: impl Fn(&str) -> bool) -> Option<Instant> {
