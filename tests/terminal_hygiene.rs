@@ -100,3 +100,158 @@ fn quits_leave_nothing_in_the_shells_input() {
     quits(0);
     other.join().unwrap();
 }
+
+/// The pid of the shell's child running ballpit.
+fn app_pid(sh: &Link) -> u32 {
+    let shell = sh.child.process_id().unwrap();
+    let end = Instant::now() + Duration::from_secs(10);
+    loop {
+        for e in std::fs::read_dir("/proc").unwrap().flatten() {
+            let Ok(stat) = std::fs::read_to_string(e.path().join("stat")) else {
+                continue;
+            };
+            let Some(close) = stat.rfind(')') else {
+                continue;
+            };
+            let name = &stat[stat.find('(').unwrap() + 1..close];
+            let ppid: Option<u32> = stat[close + 2..]
+                .split_whitespace()
+                .nth(1)
+                .and_then(|p| p.parse().ok());
+            if name == "ballpit" && ppid == Some(shell) {
+                return e.file_name().to_str().unwrap().parse().unwrap();
+            }
+        }
+        assert!(Instant::now() < end, "no ballpit under the shell");
+        thread::sleep(Duration::from_millis(20));
+    }
+}
+
+fn kill(sig: &str, pid: u32) {
+    let st = std::process::Command::new("kill")
+        .args([&format!("-{sig}"), &pid.to_string()])
+        .status()
+        .unwrap();
+    assert!(st.success(), "kill -{sig} {pid}");
+}
+
+/// The shell has the terminal: its screen, the cursor shown, and a typed
+/// command runs (its text echoed, its output printed).
+fn shell_is_usable(sh: &Link, n: u32) {
+    let back = sh.wait_for(20.0, |_| sh.modes() == (false, false));
+    assert!(
+        back.is_some(),
+        "the shell's screen did not come back: {}",
+        sh.text()
+    );
+    line(sh, &format!("echo typed$(({n}*2))"));
+    let want = format!("typed{}", n * 2);
+    let ran = sh.wait_for(20.0, |s| {
+        s.contains(&format!("echo typed$(({n}*2))")) && s.lines().any(|l| l.trim() == want)
+    });
+    assert!(
+        ran.is_some(),
+        "the typed command did not run: {}",
+        sh.text()
+    );
+}
+
+/// Rows of the screen with something drawn on them.
+fn drawn_rows(text: &str) -> usize {
+    text.lines().filter(|l| !l.trim().is_empty()).count()
+}
+
+/// `fg` resumes the app: the whole screen is drawn again (the model's
+/// alternate screen was blanked while the shell had the terminal), and a
+/// key acts at once (raw mode: no Enter).
+fn fg_repaints(sh: &Link) {
+    sh.blank_alternate();
+    line(sh, "fg");
+    let full = sh.wait_for(20.0, |s| {
+        sh.modes() == (true, true) && s.contains("threading") && drawn_rows(s) >= 38
+    });
+    assert!(full.is_some(), "not repainted after fg: {}", sh.text());
+    let tick = |s: &str| common::link::readout(s, "tick").map(str::to_string);
+    let before = tick(&sh.text());
+    sh.send(b"]");
+    let moved = sh.wait_for(20.0, |s| tick(s) != before && drawn_rows(s) >= 38);
+    assert!(moved.is_some(), "`]` had no effect after fg: {}", sh.text());
+}
+
+#[test]
+fn ctrl_z_sigtstp_and_sigstop_give_the_shell_back_and_fg_repaints() {
+    let sh = shell();
+    line(&sh, &format!("{BIN} --tick 5"));
+    wait_app(&sh);
+    let pid = app_pid(&sh);
+
+    // Ctrl-Z as a key (the app's terminal is raw).
+    sh.send(b"\x1a");
+    shell_is_usable(&sh, 21);
+    fg_repaints(&sh);
+
+    // SIGTSTP from elsewhere.
+    kill("TSTP", pid);
+    shell_is_usable(&sh, 22);
+    fg_repaints(&sh);
+
+    // SIGSTOP, which the app cannot see: the shell prompts over its screen;
+    // the SIGCONT of `fg` puts raw mode and the screen back.
+    sh.blank();
+    kill("STOP", pid);
+    let stopped = sh.wait_for(20.0, |s| s.contains("Stopped"));
+    assert!(stopped.is_some(), "{}", sh.text());
+    // A stop the app cannot see leaves the answers to its last requests to
+    // the shell; they are on the line being typed: kill the line (Ctrl-U).
+    thread::sleep(Duration::from_millis(300));
+    sh.send(b"\x15");
+    fg_repaints(&sh);
+
+    sh.send(b"q");
+    let back = sh.wait_for(20.0, |_| sh.modes() == (false, false));
+    assert!(back.is_some(), "q did not end the app: {}", sh.text());
+    line(&sh, "printf 'rc=%d|\\n' $?");
+    assert_eq!(printed(&sh, "rc"), "0");
+    assert_eq!(sh.modes(), (false, false));
+}
+
+#[test]
+fn every_fatal_signal_restores_the_terminal() {
+    use signal_hook::consts as c;
+    let signals = [
+        ("HUP", c::SIGHUP),
+        ("INT", c::SIGINT),
+        ("QUIT", c::SIGQUIT),
+        ("TERM", c::SIGTERM),
+        ("USR1", c::SIGUSR1),
+        ("USR2", c::SIGUSR2),
+        ("ALRM", c::SIGALRM),
+        ("VTALRM", c::SIGVTALRM),
+        ("PROF", c::SIGPROF),
+        ("XCPU", c::SIGXCPU),
+        ("XFSZ", c::SIGXFSZ),
+        ("PIPE", c::SIGPIPE),
+    ];
+    let sh = shell();
+    // QUIT, XCPU and XFSZ dump core by default: not into the test's tree.
+    line(&sh, "ulimit -c 0");
+    for (i, (name, sig)) in signals.into_iter().enumerate() {
+        sh.blank();
+        // A line of its own: bash drops the rest of a list whose command
+        // died of SIGINT.
+        line(&sh, BIN);
+        wait_app(&sh);
+        kill(name, app_pid(&sh));
+        let back = sh.wait_for(20.0, |_| sh.modes() == (false, false));
+        assert!(back.is_some(), "SIG{name}: the screen is still the app's");
+        line(&sh, &format!("printf 's%d=%d|\\n' {i} $?"));
+        let rc = printed(&sh, &format!("s{i}"));
+        assert_eq!(rc, (128 + sig).to_string(), "SIG{name}: exit status");
+        assert_eq!(
+            sh.modes(),
+            (false, false),
+            "SIG{name}: alternate screen on or cursor hidden"
+        );
+        shell_is_usable(&sh, 100 + u32::try_from(i).unwrap());
+    }
+}

@@ -219,6 +219,15 @@ impl Link {
         self.screen.lock().unwrap().process(b"\x1b[2J");
     }
 
+    /// Blank the model's alternate screen too, leaving the normal one on:
+    /// what the app shows there next it must have drawn again.
+    pub fn blank_alternate(&self) {
+        self.screen
+            .lock()
+            .unwrap()
+            .process(b"\x1b[?1049h\x1b[2J\x1b[?1049l");
+    }
+
     /// When `pred` first held for the screen (polled every millisecond),
     /// or None at the deadline.
     pub fn wait_for(&self, secs: f64, pred: impl Fn(&str) -> bool) -> Option<Instant> {
