@@ -2,6 +2,8 @@
 //! Numbers are written in Rust's shortest round-trip form, so a dump reads
 //! back bit for bit (ryu, which csv's serializer uses, writes 3.4e-5 as
 //! 0.000034, hence the strings).
+use super::MAX_COUNT;
+use super::bounded::Bound;
 use super::place::{Overlaps, check_with};
 use crate::error::BadInput;
 use crate::physics::{Sphere, World};
@@ -12,9 +14,21 @@ use std::path::Path;
 
 pub const HEADER: [&str; 8] = ["x", "y", "z", "vx", "vy", "vz", "radius", "mass"];
 
+/// What a sphere CSV may hold, decided before reading: `MAX_COUNT` rows of
+/// at most 256 bytes (a row of eight shortest round-trip numbers is at most
+/// about 200).
+pub const BOUND: Bound = Bound {
+    kind: "CSV",
+    max_bytes: MAX_COUNT as u64 * 256 + 1024,
+    max_line: 1024,
+    // The header, the rows and some blank lines.
+    max_lines: MAX_COUNT + 1024,
+    why: "10000000 spheres, 256 bytes a row",
+};
+
 pub fn read(path: &Path, size: f64, overlaps: Overlaps) -> Result<World, BadInput> {
     let name = path.display().to_string();
-    let text = super::read_text(path)?;
+    let text = super::bounded::read_text(path, &BOUND)?;
     parse_with(&text, size, &name, overlaps)
 }
 

@@ -1,15 +1,16 @@
 //! Scenes: the presets, TOML scene files and sphere CSVs, turned into a
 //! checked [`World`].
+pub mod bounded;
 pub mod csv_io;
 pub mod lattice;
 pub mod place;
 pub mod presets;
 pub mod toml_file;
 
+use crate::bad;
 use crate::error::BadInput;
 use crate::physics::sphere::volume;
 use crate::physics::{ModelKind, Sphere, World};
-use crate::{bad, bad_input};
 use glam::DVec3;
 use std::path::Path;
 
@@ -49,15 +50,14 @@ fn label(flag: &str, given_as_flag: bool, file_with_key: Option<&str>) -> String
     }
 }
 
-/// The text of a scene file, or a message saying where it is not UTF-8.
+/// The bytes of a scene file as text, or a message saying where they are
+/// not UTF-8.
 #[allow(clippy::naive_bytecount)] // once per bad file: no crate for it
-pub(crate) fn read_text(path: &Path) -> Result<String, BadInput> {
-    let bytes = std::fs::read(path)
-        .map_err(|e| bad_input!("cannot read scene file {}: {e}", path.display()))?;
+pub(crate) fn utf8(bytes: Vec<u8>, name: &str) -> Result<String, BadInput> {
     String::from_utf8(bytes).or_else(|e| {
         let at = e.utf8_error().valid_up_to();
         let line = e.as_bytes()[..at].iter().filter(|&&b| b == b'\n').count() + 1;
-        bad!("{} line {line}: not UTF-8 text", path.display())
+        bad!("{name} line {line}: not UTF-8 text")
     })
 }
 

@@ -13,6 +13,7 @@
 //! radius = 0.05
 //! mass = 1.0              # optional, default: volume (density 1)
 //! ```
+use super::bounded::Bound;
 use crate::bad;
 use crate::error::BadInput;
 use serde::Deserialize;
@@ -51,8 +52,19 @@ fn three<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
     })
 }
 
+/// What a TOML scene may hold, decided before reading: `MAX_SPHERES`
+/// entries of at most 1 KB (an entry with four keys of long numbers is
+/// about 150 bytes), and the preset keys.
+pub const BOUND: Bound = Bound {
+    kind: "TOML",
+    max_bytes: MAX_SPHERES as u64 * 1024 + 64 * 1024,
+    max_line: 4096,
+    max_lines: MAX_SPHERES * 64 + 1024,
+    why: "100000 [[sphere]] entries, 1 KB an entry",
+};
+
 pub fn read(path: &Path) -> Result<SceneFile, BadInput> {
-    let text = super::read_text(path)?;
+    let text = super::bounded::read_text(path, &BOUND)?;
     parse(&text, &path.display().to_string())
 }
 
