@@ -20,10 +20,13 @@ pub fn sphere_bytes(model: ModelKind) -> u64 {
 /// bytes each).
 const SCREEN_BYTES: u64 = 130;
 
-/// What the process takes before any sphere: code, threads, buffers.
-const BASE_BYTES: u64 = 64 << 20;
+/// What the run still takes after the check whatever the count: threads'
+/// stacks, the screen's buffers. Counted once, and not halved with the
+/// share: a run of no sphere needs only this.
+const FIXED_BYTES: u64 = 16 << 20;
 
-/// The share of the memory the machine has free that a run may plan on.
+/// The share of the memory left, once the fixed cost is paid, that the
+/// spheres may plan on.
 const SHARE: f64 = 0.5;
 
 /// Bytes a world of `count` spheres needs headless under `model`, or in the
@@ -41,16 +44,23 @@ pub fn need(count: usize, model: Option<ModelKind>) -> u64 {
         },
         sphere_bytes,
     );
-    BASE_BYTES.saturating_add((count as u64).saturating_mul(per))
+    FIXED_BYTES.saturating_add((count as u64).saturating_mul(per))
 }
 
-/// `MemAvailable` of `/proc/meminfo`, or the address-space limit
-/// (`ulimit -v`) if that is lower, in bytes (`None` when neither is known).
+/// `MemAvailable` of `/proc/meminfo`, or what the address-space limit
+/// (`ulimit -v`) leaves beyond what the process already maps, if that is
+/// lower, in bytes (`None` when neither is known).
 pub fn available() -> Option<u64> {
     let free = std::fs::read_to_string("/proc/meminfo")
         .ok()
         .and_then(|t| parse_meminfo(&t));
-    let limit = rustix::process::getrlimit(rustix::process::Resource::As).current;
+    let mapped = std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|t| parse_kb(&t, "VmSize:"))
+        .unwrap_or(0);
+    let limit = rustix::process::getrlimit(rustix::process::Resource::As)
+        .current
+        .map(|l| l.saturating_sub(mapped));
     match (free, limit) {
         (Some(f), Some(l)) => Some(f.min(l)),
         (f, l) => f.or(l),
@@ -59,7 +69,12 @@ pub fn available() -> Option<u64> {
 
 /// The `MemAvailable:` line of a meminfo text, in bytes.
 pub fn parse_meminfo(text: &str) -> Option<u64> {
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    parse_kb(text, "MemAvailable:")
+}
+
+/// The `key  N kB` line of a /proc text, in bytes.
+fn parse_kb(text: &str, key: &str) -> Option<u64> {
+    let line = text.lines().find(|l| l.starts_with(key))?;
     let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kb.saturating_mul(1024))
 }
@@ -71,14 +86,21 @@ pub fn check(count: usize, model: Option<ModelKind>, free: Option<u64>) -> Resul
         return Ok(());
     };
     let need = need(count, model);
-    let allowed = (free as f64 * SHARE) as u64;
+    // The fixed cost once, then a share of the rest for the spheres.
+    let allowed = if free < FIXED_BYTES {
+        0
+    } else {
+        FIXED_BYTES + ((free - FIXED_BYTES) as f64 * SHARE) as u64
+    };
     if need <= allowed {
         return Ok(());
     }
     Err(format!(
-        "{count} spheres would need about {} of memory{}, more than half of the {} available (free memory, or ulimit -v if lower)",
+        "{count} spheres would need about {} of memory{}, more than the {} a run may plan on: {} for the process and half of the rest of the {} available (free memory, or what ulimit -v leaves if lower)",
         mib(need),
         model.map_or(String::new(), |m| format!(" with {m}")),
+        mib(allowed),
+        mib(FIXED_BYTES),
         mib(free)
     ))
 }
@@ -120,7 +142,7 @@ mod tests {
         assert!(check(1_000_000, Some(ModelKind::Swept), free).is_ok());
         let err = check(10_000_000, Some(ModelKind::Exact), free).unwrap_err();
         assert!(
-            err.starts_with("10000000 spheres would need about 2448 MiB"),
+            err.starts_with("10000000 spheres would need about 2400 MiB"),
             "{err}"
         );
         assert!(
@@ -135,6 +157,15 @@ mod tests {
         );
         // No figure from the system: nothing to check against.
         assert!(check(usize::MAX, None, None).is_ok());
+        // The fixed cost is counted once: a run of no sphere or one needs
+        // only it (issue 27: 64 MiB claimed under `ulimit -v 60000`).
+        let tight = Some(40u64 << 20);
+        assert!(check(0, Some(ModelKind::Swept), tight).is_ok());
+        assert!(check(1, Some(ModelKind::Swept), tight).is_ok());
+        // Half of the 24 MiB beyond it: 44 000 spheres at 285 bytes.
+        assert!(check(44_000, Some(ModelKind::Swept), tight).is_ok());
+        assert!(check(45_000, Some(ModelKind::Swept), tight).is_err());
+        assert!(check(0, Some(ModelKind::Swept), Some(8 << 20)).is_err());
         assert_eq!(need(usize::MAX, None), u64::MAX);
     }
 }

@@ -252,12 +252,12 @@ fn tempdir() -> std::path::PathBuf {
 
 #[test]
 fn a_count_the_memory_cannot_hold_is_refused_with_the_figure() {
-    // Under a 600 MB address-space limit: a million spheres need about 306
-    // MiB with exact, more than half the limit, so they are refused before
-    // the model allocates anything.
+    // Under a 400 MB address-space limit: a million spheres need about 270
+    // MiB with exact, more than the fixed cost and half of what the limit
+    // leaves, so they are refused before the model allocates anything.
     let run = |model: &str| {
         let line = format!(
-            "ulimit -v 600000; exec {} bench --count 1000000 --radius 0.001 --model {model} --steps 0",
+            "ulimit -v 400000; exec {} bench --count 1000000 --radius 0.001 --model {model} --steps 0",
             assert_cmd::cargo::cargo_bin("ballpit").display()
         );
         std::process::Command::new("sh")
@@ -269,7 +269,7 @@ fn a_count_the_memory_cannot_hold_is_refused_with_the_figure() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
-        err.starts_with("ballpit: 1000000 spheres would need about 3")
+        err.starts_with("ballpit: 1000000 spheres would need about 2")
             && err.contains("with exact"),
         "{err}"
     );
