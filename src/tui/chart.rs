@@ -4,7 +4,7 @@
 //! numbered group (`pool-N`) is drawn as its mean and its max, and the
 //! legend says so. The axes are in percent of one core and seconds.
 use super::theme::Palette;
-use super::threads::split_group;
+use super::threads::{ordered, split_group};
 use crate::cpu::{CpuReport, history};
 use ratatui::buffer::Buffer;
 use ratatui::layout::{Constraint, Layout, Rect};
@@ -47,7 +47,7 @@ pub fn series(report: &CpuReport) -> Vec<Series> {
         values: t.history.clone(),
     };
     if report.threads.len() <= MAX_LINES {
-        return report.threads.iter().map(one).collect();
+        return ordered(report).into_iter().map(one).collect();
     }
     let (singles, group) = split_group(report);
     let mut out: Vec<Series> = singles.into_iter().map(one).collect();
