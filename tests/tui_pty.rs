@@ -50,8 +50,8 @@ fn thread_loads(screen: &str) -> Vec<(String, f64)> {
         // `name [TID] 8.6 %`: the figure is the number before the `%`.
         let at = cells.iter().position(|c| *c == "%").unwrap_or(0);
         if at >= 2
-            && cells[0] != "thread"
-            && cells[0] != "process"
+            && !["thread", "process", "other"].contains(&cells[0])
+            && cells[1] != "total"
             && let Ok(p) = cells[at - 1].parse::<f64>()
         {
             out.push((cells[0].to_string(), p));

@@ -56,6 +56,14 @@ pub fn scale_top(report: &CpuReport) -> f64 {
         .iter()
         .flat_map(|t| t.history.iter().copied().chain([t.percent]))
         .fold(1.0, f64::max);
+    nice_ceiling(peak)
+}
+
+/// The least of 1, 2 or 5 times a power of ten (from 1) at or above `peak`.
+pub fn nice_ceiling(peak: f64) -> f64 {
+    if !peak.is_finite() {
+        return 100.0;
+    }
     let mut step = 1.0;
     loop {
         for m in [1.0, 2.0, 5.0] {
