@@ -132,3 +132,25 @@ fn the_no_terminal_message_names_ballpit_once_and_its_advice_runs() {
     assert_eq!(code, Some(0), "`{advice}`: {err}");
     assert!(!out.is_empty());
 }
+
+#[test]
+fn the_man_page_has_keys_and_no_pages_it_does_not_ship() {
+    let out = ballpit().arg("man").output().unwrap();
+    assert!(out.status.success());
+    let page = String::from_utf8(out.stdout).unwrap();
+    assert!(page.contains(".SH KEYS"), "{page}");
+    for b in ballpit::tui::keys::TABLE {
+        let help = b.help.replace('-', "\\-");
+        assert!(page.contains(&help), "KEYS lacks `{}`", b.help);
+    }
+    // Only ballpit(1) is generated: no reference to another page.
+    assert!(!page.contains("(1)"), "{page}");
+    assert!(!page.contains("ballpit\\-bench"), "{page}");
+    for sub in ["BALLPIT BENCH", "BALLPIT TRADEOFF", "EXIT STATUS"] {
+        assert!(page.contains(sub), "no {sub}");
+    }
+    assert!(
+        page.contains("\\-\\-steps"),
+        "bench's options are in the page"
+    );
+}

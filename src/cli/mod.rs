@@ -6,7 +6,7 @@ mod screen;
 mod values;
 
 pub use crate::tui::MAX_FPS;
-pub use help::BENCH_FIELDS;
+pub use help::{BENCH_FIELDS, keys_section};
 pub use values::{ColorArg, ModelArg, ThreadingArg};
 
 use crate::bad;
@@ -181,6 +181,11 @@ impl Cli {
             ));
         }
         w
+    }
+
+    /// The man page (roff) of the whole command line, with its keys.
+    pub fn man_page() -> std::io::Result<Vec<u8>> {
+        help::man_page(&Cli::command())
     }
 
     /// The validated screen options.
