@@ -68,6 +68,7 @@ fn order_percent_base_and_pool_total_at_three_sizes_and_four_pools() {
             let panel = Threads {
                 report: &r,
                 palette: Palette::Mono,
+                by_cpu: false,
             };
             let (iw, ih) = (usize::from(area.width) - 2, usize::from(area.height) - 2);
             let layout = panel.layout(iw, ih);
@@ -76,6 +77,7 @@ fn order_percent_base_and_pool_total_at_three_sizes_and_four_pools() {
                     Threads {
                         report: &r,
                         palette: Palette::Mono,
+                        by_cpu: false,
                     },
                     f.area(),
                 );
@@ -159,4 +161,51 @@ fn sparklines_tell_one_percent_from_fifteen() {
     r.threads[2].history = vec![95.0];
     assert_eq!(threads::scale_top(&r), 100.0);
     assert_eq!(threads::sparkline(&[0.0], 1, 100.0), " ");
+}
+
+#[test]
+fn s_sorts_the_rows_by_cpu_and_back() {
+    use ballpit::tui::input::Action;
+    use ballpit::tui::state::AppState;
+    let r = report(2);
+    let draw = |by_cpu| {
+        let mut t = Terminal::new(TestBackend::new(70, 16)).unwrap();
+        t.draw(|f| {
+            f.render_widget(
+                Threads {
+                    report: &r,
+                    palette: Palette::Mono,
+                    by_cpu,
+                },
+                f.area(),
+            );
+        })
+        .unwrap();
+        rows(&t)
+    };
+    let at = |text: &[String], name: &str| {
+        let pat = format!("│{name} ");
+        text.iter().position(|l| l.contains(&pat)).unwrap()
+    };
+    let fixed = draw(false);
+    assert!(at(&fixed, "main") < at(&fixed, "pool-0"), "{fixed:#?}");
+    let busy = draw(true);
+    // pool-0 at 40 % above main at 3.1 % above physics at 1.2 %.
+    assert!(at(&busy, "pool-0") < at(&busy, "main"), "{busy:#?}");
+    assert!(at(&busy, "main") < at(&busy, "physics"), "{busy:#?}");
+    assert!(busy[0].contains("threads by CPU"), "{busy:#?}");
+    // The key toggles the state the panel reads.
+    let settings = ballpit::engine::Settings {
+        model: ballpit::physics::ModelKind::Swept,
+        dt: 1.0 / 60.0,
+        tick: 1,
+        threading: ballpit::engine::Threading::Off,
+        threads: 2,
+    };
+    let mut st = AppState::new(&settings, 4, 0.1, 30.0);
+    assert!(!st.threads_by_cpu);
+    assert!(st.apply(Action::SortThreads).is_empty());
+    assert!(st.threads_by_cpu);
+    st.apply(Action::SortThreads);
+    assert!(!st.threads_by_cpu);
 }

@@ -32,6 +32,8 @@ pub enum Action {
     FasterFps,
     /// Swap the canvas for the chart of per-thread CPU, and back.
     Chart,
+    /// Sort the thread panel by CPU, and back to its fixed order.
+    SortThreads,
 }
 
 /// The key a press means, if any (releases are ignored). The keys are in
@@ -95,6 +97,7 @@ mod tests {
             (KeyCode::Char('f'), Action::SlowerFps),
             (KeyCode::Char('F'), Action::FasterFps),
             (KeyCode::Char('c'), Action::Chart),
+            (KeyCode::Char('s'), Action::SortThreads),
         ];
         for (code, want) in table {
             assert_eq!(action(press(code)), Some(want), "{code:?}");

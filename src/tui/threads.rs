@@ -27,6 +27,8 @@ const ENTRY_W: usize = 20;
 pub struct Threads<'a> {
     pub report: &'a CpuReport,
     pub palette: Palette,
+    /// Busiest first (key `s`) instead of the fixed order.
+    pub by_cpu: bool,
 }
 
 /// `values` (percent of one core) as bars, newest last, at most `width`,
@@ -147,6 +149,7 @@ pub fn full_height(report: &CpuReport) -> u16 {
     let t = Threads {
         report,
         palette: Palette::Mono,
+        by_cpu: false,
     };
     t.lines(usize::from(u16::MAX)).len() as u16 + 2
 }
@@ -157,6 +160,7 @@ pub fn compact_height(report: &CpuReport, inner_width: usize) -> u16 {
     let t = Threads {
         report,
         palette: Palette::Mono,
+        by_cpu: false,
     };
     t.compact_lines(inner_width, usize::MAX).len() as u16 + 2
 }
@@ -182,6 +186,14 @@ impl Threads<'_> {
             Color::Green
         };
         Style::new().fg(c)
+    }
+
+    /// `threads` busiest first when sorting by CPU (ties in the fixed order).
+    fn sorted<'t>(&self, mut threads: Vec<&'t ThreadLoad>) -> Vec<&'t ThreadLoad> {
+        if self.by_cpu {
+            threads.sort_by(|a, b| b.percent.total_cmp(&a.percent));
+        }
+        threads
     }
 
     /// `of 200 %`: what 100 % of every CPU this process may use adds up to.
@@ -256,7 +268,7 @@ impl Threads<'_> {
         if self.report.threads.is_empty() {
             lines.push(Line::from("(no per-thread figures yet)"));
         }
-        for t in ordered(self.report) {
+        for t in self.sorted(ordered(self.report)) {
             let id = if tid {
                 format!(" {:>7}", t.tid)
             } else {
@@ -305,7 +317,7 @@ impl Threads<'_> {
     /// Every thread's figure in columns, the pool total and the totals.
     pub fn column_lines(&self, width: usize) -> Vec<Line<'static>> {
         let label = self.palette.label();
-        let all = ordered(self.report);
+        let all = self.sorted(ordered(self.report));
         let mut lines = Self::columns(&all, width);
         if all.is_empty() {
             lines.push(Line::from("(no per-thread figures yet)"));
@@ -328,7 +340,7 @@ impl Threads<'_> {
     pub fn compact_lines(&self, width: usize, height: usize) -> Vec<Line<'static>> {
         let label = self.palette.label();
         let (singles, group) = split_group(self.report);
-        let mut lines = Self::columns(&singles, width);
+        let mut lines = Self::columns(&self.sorted(singles), width);
         if self.report.threads.is_empty() {
             lines.push(Line::from("(no per-thread figures yet)"));
         }
@@ -440,7 +452,12 @@ fn padded(name: &str, w: usize) -> String {
 
 impl Widget for Threads<'_> {
     fn render(self, area: Rect, buf: &mut Buffer) {
-        let block = Block::bordered().title(" threads: CPU %, 100 % = one core ");
+        let title = if self.by_cpu {
+            " threads by CPU %, 100 % = one core "
+        } else {
+            " threads: CPU %, 100 % = one core "
+        };
+        let block = Block::bordered().title(title);
         let inner = block.inner(area);
         block.render(area, buf);
         let (w, h) = (usize::from(inner.width), usize::from(inner.height));
