@@ -89,7 +89,9 @@ pub fn warnings(report: &BenchReport) -> Vec<String> {
         w.push(format!("{} spheres ended outside the cube", report.escaped));
     }
     if report.n > 0 && report.energy_start == 0.0 {
-        w.push("every sphere is at rest: the energy figures are 0 and say nothing".into());
+        // Zero energy is a world at rest or masses too small for f64 (5e-324
+        // at 0.1 box/s): the figure, not the motion, is what is known.
+        w.push("the kinetic energy is 0 (spheres at rest, or masses too small to give an energy in f64): the energy figures say nothing".into());
     }
     w
 }

@@ -58,11 +58,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             clap_complete::generate(shell, &mut Cli::command(), "ballpit", &mut script);
             Ok(emit(&script)?)
         }
-        Some(Command::Man) => {
-            let mut page = Vec::new();
-            clap_mangen::Man::new(Cli::command()).render(&mut page)?;
-            Ok(emit(&page)?)
-        }
+        Some(Command::Man) => Ok(emit(&Cli::man_page()?)?),
         None => cli.run_screen(None),
     }
 }

@@ -315,11 +315,31 @@ pub fn run(world: &World, out: Option<&Path>) -> anyhow::Result<String> {
         })?;
     }
     let bar = progress_bar();
+    // The reference run alone takes seconds to minutes: a named thread ticks
+    // the bar (spinner and clock) four times a second until it is finished.
+    let ticker = (!bar.is_hidden())
+        .then(|| {
+            let bar = bar.clone();
+            std::thread::Builder::new()
+                .name("progress".into())
+                .spawn(move || {
+                    while !bar.is_finished() {
+                        bar.tick();
+                        std::thread::park_timeout(std::time::Duration::from_millis(250));
+                    }
+                })
+                .ok()
+        })
+        .flatten();
     let rows = measure_with(world, &mut |done, next| {
         bar.set_position(done as u64);
         bar.set_message(next.to_string());
     });
     bar.finish_and_clear();
+    if let Some(t) = ticker {
+        t.thread().unpark();
+        let _ = t.join();
+    }
     if let Some(dir) = out {
         let csv_path = dir.join("tradeoff.csv");
         std::fs::write(&csv_path, csv(&rows)?)
@@ -337,7 +357,9 @@ fn progress_bar() -> ProgressBar {
     }
     let bar = ProgressBar::new(RUNS as u64);
     // The template is a constant: it either parses or fails here alike.
-    if let Ok(style) = ProgressStyle::with_template("{bar:20} {pos}/{len} runs, {elapsed}: {msg}") {
+    if let Ok(style) =
+        ProgressStyle::with_template("{spinner} {bar:20} {pos}/{len} runs, {elapsed}: {msg}")
+    {
         bar.set_style(style);
     }
     bar

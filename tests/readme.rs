@@ -1,7 +1,9 @@
 //! The README against the repository and the real command line: every
 //! relative link and every repository path it names exists, every command
 //! in its `sh` blocks parses with the real CLI and its flags and scene
-//! validate, and its TOML example is a scene ballpit reads.
+//! validate, runs as written from a temporary directory with `ballpit` on
+//! the PATH as its install step puts it there, and changes no tracked file;
+//! and its TOML example is a scene ballpit reads.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use ballpit::cli::{Cli, Command, SceneArgs};
 use ballpit::scene::{self, presets};
@@ -165,7 +167,7 @@ fn ballpit_args(line: &str) -> Option<Vec<String>> {
                 .chain(rest.iter().map(std::string::ToString::to_string))
                 .collect(),
         ),
-        ["cargo", "test", "--release"] => None,
+        ["cargo", "test", "--release"] | ["cargo", "install", "--path", "."] => None,
         _ => panic!("README shows a command this test does not know: `{line}`"),
     }
 }
@@ -254,4 +256,171 @@ fn every_preset_is_named_in_the_readme() {
     for p in presets::PRESETS {
         assert!(README.contains(&format!("`{}`", p.name)), "{}", p.name);
     }
+}
+
+/// `line` run by `sh` in `dir` with `bin` first on the PATH, in a 100x30
+/// pty: it must draw the app (its `threading` readout), then quit on `q`
+/// with status 0.
+fn run_app(line: &str, dir: &Path, bin: &Path) {
+    use portable_pty::{CommandBuilder, PtySize, native_pty_system};
+    use std::io::{Read, Write};
+    use std::sync::{Arc, Mutex};
+    let pty = native_pty_system()
+        .openpty(PtySize {
+            rows: 30,
+            cols: 100,
+            pixel_width: 0,
+            pixel_height: 0,
+        })
+        .unwrap();
+    let mut cmd = CommandBuilder::new("sh");
+    cmd.args(["-c", line]);
+    cmd.cwd(dir);
+    cmd.env("PATH", path_with(bin));
+    cmd.env("TERM", "xterm-256color");
+    let mut child = pty.slave.spawn_command(cmd).unwrap();
+    drop(pty.slave);
+    let mut reader = pty.master.try_clone_reader().unwrap();
+    let mut writer = pty.master.take_writer().unwrap();
+    let screen = Arc::new(Mutex::new(vt100::Parser::new(nz(30), nz(100), 0)));
+    let s = screen.clone();
+    let read = std::thread::spawn(move || {
+        let mut buf = vec![0u8; 65536];
+        while let Ok(n) = reader.read(&mut buf) {
+            if n == 0 {
+                break;
+            }
+            s.lock().unwrap().process(&buf[..n]);
+        }
+    });
+    let wait = |what: &str, ok: &dyn Fn() -> bool| {
+        let end = std::time::Instant::now() + std::time::Duration::from_secs(20);
+        while !ok() {
+            assert!(
+                std::time::Instant::now() < end,
+                "`{line}`: no {what}; screen:\n{}",
+                screen.lock().unwrap().screen().contents()
+            );
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        }
+    };
+    wait("app drawn", &|| {
+        screen
+            .lock()
+            .unwrap()
+            .screen()
+            .contents()
+            .contains("threading")
+    });
+    writer.write_all(b"q").unwrap();
+    writer.flush().unwrap();
+    let end = std::time::Instant::now() + std::time::Duration::from_secs(20);
+    let st = loop {
+        if let Some(st) = child.try_wait().unwrap() {
+            break st;
+        }
+        assert!(
+            std::time::Instant::now() < end,
+            "`{line}`: q did not end it"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    };
+    assert!(st.success(), "`{line}` ended with {st:?}");
+    drop(writer);
+    drop(pty.master);
+    let _ = read.join();
+}
+
+fn path_with(bin: &Path) -> String {
+    format!(
+        "{}:{}",
+        bin.display(),
+        std::env::var("PATH").unwrap_or_default()
+    )
+}
+
+/// `git status --porcelain` of the repository: what differs from HEAD.
+fn tracked_changes() -> String {
+    let out = std::process::Command::new("git")
+        .args(["status", "--porcelain", "--untracked-files=no"])
+        .current_dir(root())
+        .output()
+        .expect("git runs: the test checks tracked files with it");
+    assert!(out.status.success(), "not a git checkout");
+    String::from_utf8(out.stdout).unwrap()
+}
+
+#[test]
+fn every_readme_command_runs_as_written_and_changes_no_tracked_file() {
+    let before = tracked_changes();
+    let dir = std::env::temp_dir().join(format!("ballpit-readme-run-{}", std::process::id()));
+    let bin = dir.join("bin");
+    let work = dir.join("work");
+    std::fs::create_dir_all(&work).unwrap();
+    let mut installed = false;
+    let mut ran = 0;
+    for block in blocks(README, "sh") {
+        for line in block.lines() {
+            let line = line.split(" #").next().unwrap_or("").trim();
+            if line.is_empty() || line == "cargo test --release" {
+                continue;
+            }
+            if line == "cargo install --path ." {
+                // What it leaves: this very build's binary, on the PATH.
+                std::fs::create_dir_all(&bin).unwrap();
+                std::fs::copy(env!("CARGO_BIN_EXE_ballpit"), bin.join("ballpit")).unwrap();
+                installed = true;
+                continue;
+            }
+            assert!(
+                line.starts_with("ballpit"),
+                "README runs `{line}`, which this test does not know"
+            );
+            assert!(installed, "`{line}` comes before the install step");
+            let app = Cli::try_parse_checked(line.split_whitespace())
+                .unwrap_or_else(|e| panic!("`{line}`: {e}"))
+                .command
+                .is_none();
+            if app {
+                run_app(line, &work, &bin);
+            } else {
+                let out = std::process::Command::new("sh")
+                    .args(["-c", line])
+                    .current_dir(&work)
+                    .env("PATH", path_with(&bin))
+                    .output()
+                    .unwrap();
+                let err = String::from_utf8_lossy(&out.stderr);
+                assert!(out.status.success(), "`{line}`: {err}");
+                assert!(!out.stdout.is_empty(), "`{line}` printed nothing");
+                assert!(!err.contains("warning"), "`{line}`: {err}");
+            }
+            ran += 1;
+        }
+    }
+    assert!(
+        ran >= 6,
+        "only {ran} commands run: is the parser still right?"
+    );
+    // What the commands say they write, written where they ran.
+    for f in [
+        "end.csv",
+        "tradeoff-out/tradeoff.csv",
+        "tradeoff-out/tradeoff.svg",
+    ] {
+        assert!(
+            work.join(f).exists(),
+            "{f} not written in the work directory"
+        );
+    }
+    assert_eq!(
+        tracked_changes(),
+        before,
+        "README commands changed tracked files"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+fn nz(n: u16) -> std::num::NonZeroU16 {
+    std::num::NonZeroU16::new(n).unwrap()
 }

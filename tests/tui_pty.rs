@@ -47,10 +47,12 @@ fn thread_loads(screen: &str) -> Vec<(String, f64)> {
         }
         let row = parts[parts.len() - 2];
         let cells: Vec<&str> = row.split_whitespace().collect();
-        if cells.len() >= 2
-            && cells[0] != "thread"
-            && cells[0] != "total"
-            && let Ok(p) = cells[1].parse::<f64>()
+        // `name [TID] 8.6 %`: the figure is the number before the `%`.
+        let at = cells.iter().position(|c| *c == "%").unwrap_or(0);
+        if at >= 2
+            && !["thread", "process", "other"].contains(&cells[0])
+            && cells[1] != "total"
+            && let Ok(p) = cells[at - 1].parse::<f64>()
         {
             out.push((cells[0].to_string(), p));
         }

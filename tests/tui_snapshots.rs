@@ -233,6 +233,7 @@ fn threads_panel() {
             Threads {
                 report: &r,
                 palette: Palette::C16,
+                by_cpu: false,
             },
             f.area(),
         );
@@ -348,7 +349,7 @@ const CELLS: &str = "·▁▂▃▄▅▆▇█";
 /// `k` threads when the summary says `k/cell`); and the total and others.
 fn assert_every_thread_visible(text: &[String], r: &CpuReport, what: &str) {
     let all = text.join("\n");
-    assert!(all.contains("total"), "{what}: no total\n{all}");
+    assert!(all.contains("process"), "{what}: no process total\n{all}");
     assert!(all.contains("other procs"), "{what}: no other procs\n{all}");
     let (singles, group) = ballpit::tui::threads::split_group(r);
     let summary = group.as_ref().and_then(|(prefix, members)| {
@@ -368,7 +369,7 @@ fn assert_every_thread_visible(text: &[String], r: &CpuReport, what: &str) {
                 .map_or(1, |k| k.split(' ').next().unwrap().parse().unwrap());
             let cells: usize = text[at + 1..]
                 .iter()
-                .take_while(|l| !l.contains("total"))
+                .take_while(|l| !l.contains("total") && !l.contains("idle"))
                 .map(|l| l.chars().filter(|c| CELLS.contains(*c)).count())
                 .sum();
             assert_eq!(
@@ -645,17 +646,14 @@ fn others_line_shows_what_other_processes_take() {
     let r = report_for(Threading::Pool, 2);
     let t = screen(120, 40, &mode_state(Threading::Pool, 2), &r);
     let text = rows(&t).join("\n");
-    assert!(
-        text.contains("other procs    37.5  rest of the machine"),
-        "{text}"
-    );
+    assert!(text.contains("other procs   37.5 % of 200 %"), "{text}");
     let mut r = r;
     r.others_percent = None;
     let text = rows(&screen(80, 24, &mode_state(Threading::Pool, 2), &r)).join("\n");
     // Not known yet: a dash, not a made-up zero.
     assert!(
         text.lines()
-            .any(|l| l.contains("other procs") && l.contains(" -  ")),
+            .any(|l| l.contains("other procs") && l.contains(" - % of 200 %")),
         "{text}"
     );
 }
@@ -671,7 +669,7 @@ fn two_hundred_fifty_six_pool_threads_at_80x24_share_cells_and_say_so() {
         .expect("the pool summary");
     assert!(
         text.iter()
-            .any(|l| l.contains("each cell: the busiest of 2 threads")),
+            .any(|l| l.contains("each cell: the busiest of 4 threads")),
         "{}",
         text.join("\n")
     );
@@ -680,14 +678,16 @@ fn two_hundred_fifty_six_pool_threads_at_80x24_share_cells_and_say_so() {
 }
 
 #[test]
-fn a_wide_terminal_shows_a_whole_minute_of_sparkline() {
+fn a_wide_terminal_shows_more_seconds_of_sparkline_and_the_thread_ids() {
     let r = report_for(Threading::Pool, 2);
     let text = rows(&screen(250, 60, &mode_state(Threading::Pool, 2), &r)).join("\n");
-    assert!(text.contains("last 60 s"), "{text}");
-    // The 60 one-second samples of `physics` (never idle), all drawn.
+    // The widest panel (84 columns) less name, id and figure: 52 s.
+    assert!(text.contains("last 52 s"), "{text}");
+    assert!(text.contains("TID"), "{text}");
+    // The 52 newest one-second samples of `physics` (never idle), all drawn.
     let row = text.lines().rfind(|l| l.contains("│physics ")).unwrap();
     let bars = row.chars().filter(|c| "▁▂▃▄▅▆▇█".contains(*c)).count();
-    assert_eq!(bars, 60, "{row}");
+    assert_eq!(bars, 52, "{row}");
     let text = rows(&screen(80, 24, &mode_state(Threading::Pool, 2), &r)).join("\n");
     assert!(text.contains("last 20 s"), "{text}");
 }

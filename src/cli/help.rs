@@ -114,3 +114,90 @@ pub(super) fn scene_long_help() -> String {
 pub(super) fn threads_help() -> String {
     format!("Pool threads (1 to {MAX_THREADS}) [default: available cores]")
 }
+
+/// The man page: clap's sections for `ballpit` and, in place of the list
+/// of `ballpit-bench(1)`-style pages that are not generated, a section per
+/// subcommand with its options, then the keys from the app's own table.
+pub fn man_page(cmd: &clap::Command) -> std::io::Result<Vec<u8>> {
+    let mut cmd = cmd.clone().disable_help_subcommand(true);
+    cmd.build();
+    let man = clap_mangen::Man::new(cmd.clone());
+    let mut page = Vec::new();
+    man.render_title(&mut page)?;
+    man.render_name_section(&mut page)?;
+    man.render_synopsis_section(&mut page)?;
+    man.render_description_section(&mut page)?;
+    man.render_options_section(&mut page)?;
+    for sub in cmd.get_subcommands() {
+        let name = format!("ballpit {}", sub.get_name());
+        let _ = writeln!(
+            page_text(&mut page),
+            ".SH \"{}\"\n{}",
+            roff_escape(&name.to_uppercase()),
+            roff_escape(
+                &sub.get_long_about()
+                    .or(sub.get_about())
+                    .map(ToString::to_string)
+                    .unwrap_or_default()
+            )
+        );
+        let mut opts = Vec::new();
+        clap_mangen::Man::new(sub.clone()).render_options_section(&mut opts)?;
+        // One OPTIONS section per page: the subcommand's are a subsection.
+        let opts = String::from_utf8_lossy(&opts).replacen(
+            ".SH OPTIONS",
+            &format!(".SS \"{name} options\""),
+            1,
+        );
+        page.extend_from_slice(opts.as_bytes());
+    }
+    page.extend_from_slice(keys_section().as_bytes());
+    man.render_extra_section(&mut page)?;
+    page.extend_from_slice(
+        b".SH \"EXIT STATUS\"\n0 on success; 2 for bad input (a flag, a scene file), with one message on stderr; 1 for other errors.\n",
+    );
+    man.render_version_section(&mut page)?;
+    Ok(page)
+}
+
+/// `page` as a `fmt::Write` sink for `writeln!`.
+fn page_text(page: &mut Vec<u8>) -> impl std::fmt::Write + '_ {
+    struct Sink<'a>(&'a mut Vec<u8>);
+    impl std::fmt::Write for Sink<'_> {
+        fn write_str(&mut self, s: &str) -> std::fmt::Result {
+            self.0.extend_from_slice(s.as_bytes());
+            Ok(())
+        }
+    }
+    Sink(page)
+}
+
+/// The KEYS section: every binding of the app's key table.
+pub fn keys_section() -> String {
+    let mut s = String::from(".SH KEYS\nIn the terminal app (press ? there for the same list):\n");
+    for b in crate::tui::keys::TABLE {
+        let _ = write!(
+            s,
+            ".TP\n\\fB{}\\fR\n{}\n",
+            roff_escape(&b.keys()),
+            roff_escape(b.help)
+        );
+    }
+    s
+}
+
+/// Text safe in roff: backslashes and hyphens escaped, no line starting a
+/// request.
+fn roff_escape(text: &str) -> String {
+    text.lines()
+        .map(|l| {
+            let l = l.replace('\\', "\\e").replace('-', "\\-");
+            if l.starts_with('.') || l.starts_with('\'') {
+                format!("\\&{l}")
+            } else {
+                l
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}

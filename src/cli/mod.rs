@@ -6,7 +6,7 @@ mod screen;
 mod values;
 
 pub use crate::tui::MAX_FPS;
-pub use help::BENCH_FIELDS;
+pub use help::{BENCH_FIELDS, keys_section};
 pub use values::{ColorArg, ModelArg, ThreadingArg};
 
 use crate::bad;
@@ -155,15 +155,37 @@ impl Cli {
         let matches = cmd.try_get_matches_from_mut(args)?;
         if let Some((sub, _)) = matches.subcommand() {
             let early = flags_given(&cmd, &matches);
-            if let Some(first) = early.first() {
-                let msg = format!(
-                    "{} must come after `{sub}` (ballpit {sub} {first} ...): flags before a subcommand are the terminal app's",
-                    early.join(", ")
-                );
+            if !early.is_empty() {
+                let msg = early_flags_message(&cmd, sub, &early);
                 return Err(cmd.error(clap::error::ErrorKind::ArgumentConflict, msg));
             }
         }
-        Cli::from_arg_matches(&matches).map_err(|e| e.format(&mut cmd))
+        let cli = Cli::from_arg_matches(&matches).map_err(|e| e.format(&mut cmd))?;
+        for w in cli.warnings() {
+            eprintln!("ballpit: warning: {w}");
+        }
+        Ok(cli)
+    }
+
+    /// Input that is legal but does nothing in the mode chosen.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut w = Vec::new();
+        if let Some(Command::Bench(b)) = &self.command
+            && let Some(k) = b.run.threads
+            && b.run.threading != ThreadingArg::Pool
+        {
+            // The app keeps it for `d`; a bench never switches modes.
+            w.push(format!(
+                "--threads {k} does nothing with --threading {}: it sets the pool, used with --threading pool",
+                crate::engine::Threading::from(b.run.threading).name()
+            ));
+        }
+        w
+    }
+
+    /// The man page (roff) of the whole command line, with its keys.
+    pub fn man_page() -> std::io::Result<Vec<u8>> {
+        help::man_page(&Cli::command())
     }
 
     /// The validated screen options.
@@ -173,6 +195,39 @@ impl Cli {
             color: self.color.into(),
         }
     }
+}
+
+/// What to do with flags typed before `sub`: move those `sub` takes after
+/// it, drop those only the terminal app has (`--fps`, `--color`).
+fn early_flags_message(cmd: &clap::Command, sub: &str, early: &[String]) -> String {
+    let takes = |flag: &str| {
+        cmd.find_subcommand(sub).is_some_and(|c| {
+            c.get_arguments()
+                .any(|a| a.get_long().is_some_and(|l| flag == format!("--{l}")))
+        })
+    };
+    let (movable, app_only): (Vec<&String>, Vec<&String>) = early.iter().partition(|f| takes(f));
+    let join = |v: &[&String]| v.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", ");
+    let mut parts = Vec::new();
+    if let Some(first) = movable.first() {
+        parts.push(format!(
+            "{} must come after `{sub}` (ballpit {sub} {first} ...)",
+            join(&movable)
+        ));
+    }
+    if !app_only.is_empty() {
+        let (verb, pron) = if app_only.len() == 1 {
+            ("is", "it")
+        } else {
+            ("are", "them")
+        };
+        parts.push(format!(
+            "{} {verb} the terminal app's and {} nothing for `{sub}`: drop {pron}",
+            join(&app_only),
+            if app_only.len() == 1 { "does" } else { "do" }
+        ));
+    }
+    parts.join("; ")
 }
 
 /// The long names of the top-level flags the user typed.

@@ -16,8 +16,8 @@ impl Cli {
         let opts = self.options();
         if !(std::io::stdin().is_terminal() && std::io::stdout().is_terminal()) {
             return Err(BadInput(
-                "ballpit's screen needs a terminal, but stdin or stdout is not one; \
-                 for a headless run use `ballpit bench`"
+                "the screen needs a terminal, but stdin or stdout is not one; \
+                 for a headless run use `ballpit bench --steps 600`"
                     .into(),
             )
             .into());

@@ -1,6 +1,7 @@
-//! The CPU other processes take on the machine: all CPUs' busy time from
-//! `/proc/stat` minus this process's own (`/proc/self/stat`), both in clock
-//! ticks, so "pool is slower than off" has a visible reason.
+//! The CPU other processes take on the CPUs this process may run on: their
+//! busy time from `/proc/stat` minus this process's own (`/proc/self/stat`),
+//! both in clock ticks, so "pool is slower than off" has a visible reason.
+//! Under `taskset -c 0` only CPU 0 counts, the same cores as the total.
 use std::fs;
 
 /// Clock ticks summed over every CPU, from the `cpu` line of `/proc/stat`.
@@ -41,6 +42,56 @@ pub fn parse_proc_stat(text: &str) -> Option<MachineTicks> {
     Some(MachineTicks { busy, total, cpus })
 }
 
+/// Busy and total ticks of the `cpuN` lines whose N is in `allowed` (the
+/// process's CPU set), `cpus` the number of them found.
+pub fn parse_proc_stat_for(text: &str, allowed: &[usize]) -> Option<MachineTicks> {
+    let mut sum = MachineTicks {
+        busy: 0,
+        total: 0,
+        cpus: 0,
+    };
+    for line in text.lines() {
+        let Some(rest) = line.strip_prefix("cpu") else {
+            continue;
+        };
+        let Some((n, _)) = rest.split_once(' ') else {
+            continue;
+        };
+        let Ok(n) = n.parse::<usize>() else { continue };
+        if !allowed.contains(&n) {
+            continue;
+        }
+        // The same sums as the aggregate line, on this CPU's line alone.
+        let one = parse_proc_stat(&format!("cpu {}", rest[n.to_string().len()..].trim()))?;
+        sum.busy += one.busy;
+        sum.total += one.total;
+        sum.cpus += 1;
+    }
+    (sum.cpus > 0).then_some(sum)
+}
+
+/// A CPU list as `/proc/self/status` writes `Cpus_allowed_list`: `0-3,6`.
+pub fn parse_cpu_list(list: &str) -> Option<Vec<usize>> {
+    let mut out = Vec::new();
+    for part in list.trim().split(',').filter(|p| !p.is_empty()) {
+        match part.split_once('-') {
+            Some((a, b)) => out.extend(a.trim().parse::<usize>().ok()?..=b.trim().parse().ok()?),
+            None => out.push(part.trim().parse().ok()?),
+        }
+    }
+    (!out.is_empty()).then_some(out)
+}
+
+/// The CPUs this process may run on (its affinity), from procfs; None off
+/// Linux or when unreadable.
+pub fn allowed_cpus() -> Option<Vec<usize>> {
+    let status = fs::read_to_string("/proc/self/status").ok()?;
+    let line = status
+        .lines()
+        .find_map(|l| l.strip_prefix("Cpus_allowed_list:"))?;
+    parse_cpu_list(line)
+}
+
 /// utime + stime of a `/proc/PID/stat` line, in ticks.
 pub fn stat_ticks(stat: &str) -> Option<u64> {
     let rest = &stat[stat.rfind(')')? + 1..];
@@ -55,13 +106,27 @@ pub fn stat_ticks(stat: &str) -> Option<u64> {
 #[derive(Default)]
 pub struct Others {
     last: Option<(MachineTicks, u64)>,
+    /// The CPU set measured: None for every CPU.
+    allowed: Option<Vec<usize>>,
 }
 
 impl Others {
+    /// Others measured over `allowed` CPUs only (None: every CPU).
+    pub fn on(allowed: Option<Vec<usize>>) -> Others {
+        Others {
+            last: None,
+            allowed,
+        }
+    }
+
     /// Read both files now; the load of other processes since the last
     /// call, in percent of one core. None on the first call or off Linux.
     pub fn sample(&mut self) -> Option<f64> {
-        let machine = parse_proc_stat(&fs::read_to_string("/proc/stat").ok()?)?;
+        let text = fs::read_to_string("/proc/stat").ok()?;
+        let machine = match &self.allowed {
+            Some(cpus) => parse_proc_stat_for(&text, cpus)?,
+            None => parse_proc_stat(&text)?,
+        };
         let own = stat_ticks(&fs::read_to_string("/proc/self/stat").ok()?)?;
         self.update(machine, own)
     }
@@ -128,6 +193,21 @@ procs_running 3
             cpus: 2,
         };
         assert_eq!(o.update(m2, 175), Some(0.0));
+    }
+
+    #[test]
+    fn only_the_allowed_cpus_count() {
+        let all = parse_proc_stat(STAT_A).unwrap();
+        let cpu0 = parse_proc_stat_for(STAT_A, &[0]).unwrap();
+        assert_eq!(cpu0.cpus, 1);
+        assert_eq!(cpu0.busy, 500 + 25 + 150 + 5 + 10 + 3);
+        assert_eq!(cpu0.total, cpu0.busy + 4000 + 50);
+        let both = parse_proc_stat_for(STAT_A, &[0, 1]).unwrap();
+        assert_eq!((both.busy, both.total, both.cpus), (all.busy, all.total, 2));
+        assert_eq!(parse_proc_stat_for(STAT_A, &[7]), None);
+        assert_eq!(parse_cpu_list("0-3,6\n"), Some(vec![0, 1, 2, 3, 6]));
+        assert_eq!(parse_cpu_list("1"), Some(vec![1]));
+        assert_eq!(parse_cpu_list("x"), None);
     }
 
     #[test]

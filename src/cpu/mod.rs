@@ -32,9 +32,10 @@ pub struct ThreadLoad {
 pub struct CpuReport {
     pub threads: Vec<ThreadLoad>,
     pub total_percent: f64,
+    /// The CPUs this process may run on: the base of the total and others.
     pub cores: usize,
-    /// What other processes took, percent of one core (None until two
-    /// readings, or off Linux).
+    /// What other processes took on this process's CPUs, percent of one
+    /// core (None until two readings, or off Linux).
     pub others_percent: Option<f64>,
 }
 
@@ -68,7 +69,12 @@ impl Default for Sampler {
 
 impl Sampler {
     pub fn new() -> Sampler {
-        let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
+        // The total and the others share one base: the CPUs we may run on.
+        let allowed = machine::allowed_cpus();
+        let cores = allowed.as_ref().map_or_else(
+            || std::thread::available_parallelism().map_or(1, std::num::NonZero::get),
+            Vec::len,
+        );
         Sampler {
             report: CpuReport {
                 cores,
@@ -76,7 +82,7 @@ impl Sampler {
             },
             tracks: HashMap::new(),
             origin: Instant::now(),
-            others: Others::default(),
+            others: Others::on(allowed),
             cores,
         }
     }
@@ -126,7 +132,7 @@ impl Sampler {
                 })
             })
             .collect();
-        threads.sort_by_key(|t| t.tid);
+        threads.sort_by(|a, b| order_key(a).cmp(&order_key(b)));
         self.report = CpuReport {
             total_percent: threads.iter().map(|t| t.percent).sum(),
             threads,
@@ -138,6 +144,24 @@ impl Sampler {
 
     pub fn report(&self) -> &CpuReport {
         &self.report
+    }
+}
+
+/// The order every reader shows threads in, stable from frame to frame:
+/// `main`, `physics`, the pool by number, the split's threads, then the
+/// rest by name (and id, for twins).
+pub fn order_key(t: &ThreadLoad) -> (u8, &str, u64, i32) {
+    let numbered = t
+        .name
+        .rsplit_once('-')
+        .and_then(|(p, n)| Some((p, n.parse::<u64>().ok()?)));
+    match (t.name.as_str(), numbered) {
+        ("main", _) => (0, "", 0, t.tid),
+        ("physics", _) => (1, "", 0, t.tid),
+        (_, Some(("pool", n))) => (2, "", n, t.tid),
+        (name, _) if name.starts_with("split") => (3, name, 0, t.tid),
+        (_, Some((p, n))) => (4, p, n, t.tid),
+        (name, None) => (4, name, 0, t.tid),
     }
 }
 

@@ -44,6 +44,12 @@ pub fn parse_with(
     name: &str,
     overlaps: Overlaps,
 ) -> Result<World, BadInput> {
+    if text.trim().is_empty() {
+        return bad!(
+            "{name}: the file is empty: a sphere CSV needs the header `{}` and a row a sphere",
+            HEADER.join(",")
+        );
+    }
     let mut rdr = csv::ReaderBuilder::new()
         .has_headers(true)
         .trim(csv::Trim::All)
@@ -104,6 +110,11 @@ pub fn parse_with(
             mass: v[7],
         });
         starts.push(start);
+    }
+    if spheres.is_empty() {
+        return bad!(
+            "{name}: a header and no spheres: give a row a sphere (for none, use --count 0)"
+        );
     }
     let world = World::new(size, spheres);
     check_with(&world, overlaps, name, &|i| {

@@ -17,6 +17,7 @@ use super::bounded::Bound;
 use crate::bad;
 use crate::error::BadInput;
 use serde::Deserialize;
+use std::fmt::Write as _;
 use std::path::Path;
 
 #[derive(Debug, Default, Deserialize)]
@@ -73,6 +74,15 @@ pub fn read(path: &Path) -> Result<SceneFile, BadInput> {
 pub const MAX_SPHERES: usize = 100_000;
 
 pub fn parse(text: &str, name: &str) -> Result<SceneFile, BadInput> {
+    // An empty file would silently be the default scene.
+    if text
+        .lines()
+        .all(|l| l.trim().is_empty() || l.trim().starts_with('#'))
+    {
+        return bad!(
+            "{name}: the file is empty: give `preset = \"gas\"`, overrides such as `count = 500`, or [[sphere]] entries"
+        );
+    }
     let entries = text.matches("[[sphere]]").count();
     if entries > MAX_SPHERES {
         return bad!(
@@ -81,10 +91,34 @@ pub fn parse(text: &str, name: &str) -> Result<SceneFile, BadInput> {
     }
     toml::from_str(text).or_else(|e: toml::de::Error| {
         let line = e.span().map(|s| super::line_of(text, s.start));
-        let msg = e.message().to_string();
+        let msg = short_numbers(e.message());
         match line {
             Some(l) => bad!("{name} line {l}: {msg}"),
             None => bad!("{name}: {msg}"),
         }
     })
+}
+
+/// `msg` with every number of more than 20 digits (toml prints `1e308` in
+/// full) written as `1e308`.
+fn short_numbers(msg: &str) -> String {
+    let mut out = String::new();
+    let mut run = String::new();
+    for c in msg.chars().chain(['\0']) {
+        if c.is_ascii_digit() || (c == '.' && !run.is_empty()) {
+            run.push(c);
+            continue;
+        }
+        match run.parse::<f64>() {
+            Ok(v) if run.len() > 20 => {
+                let _ = write!(out, "{v:e}");
+            }
+            _ => out.push_str(&run),
+        }
+        run.clear();
+        if c != '\0' {
+            out.push(c);
+        }
+    }
+    out
 }

@@ -123,6 +123,7 @@ pub fn draw(frame: &mut Frame, raster: &mut Raster, v: &View) {
         Threads {
             report: v.report,
             palette: v.palette,
+            by_cpu: v.state.threads_by_cpu,
         },
         a.threads,
     );

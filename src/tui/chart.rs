@@ -4,7 +4,7 @@
 //! numbered group (`pool-N`) is drawn as its mean and its max, and the
 //! legend says so. The axes are in percent of one core and seconds.
 use super::theme::Palette;
-use super::threads::split_group;
+use super::threads::{nice_ceiling, ordered, split_group};
 use crate::cpu::{CpuReport, history};
 use ratatui::buffer::Buffer;
 use ratatui::layout::{Constraint, Layout, Rect};
@@ -16,7 +16,8 @@ use ratatui::widgets::{Axis, Block, Chart, Dataset, GraphType, Paragraph, Widget
 /// More lines than this and the numbered group is drawn as mean and max.
 pub const MAX_LINES: usize = 8;
 
-const COLOURS: [Color; 10] = [
+/// Eight hues a 16-colour terminal tells apart (no dark twin of a light one).
+const COLOURS: [Color; 8] = [
     Color::LightRed,
     Color::LightGreen,
     Color::LightYellow,
@@ -24,12 +25,16 @@ const COLOURS: [Color; 10] = [
     Color::LightMagenta,
     Color::LightCyan,
     Color::White,
-    Color::Red,
-    Color::Green,
-    Color::Yellow,
+    Color::Gray,
 ];
-/// Without colour, lines are told apart by their marks.
-const MARKS: [Marker; 4] = [Marker::Braille, Marker::Dot, Marker::Block, Marker::Bar];
+/// Without colour, lines are told apart by their marks, and the legend by
+/// the glyph each draws with.
+const MARKS: [(Marker, &str); 4] = [
+    (Marker::Braille, "━"),
+    (Marker::Dot, "•"),
+    (Marker::Block, "█"),
+    (Marker::Bar, "▄"),
+];
 
 /// One line of the chart: its legend name and its values, oldest first,
 /// one a second.
@@ -37,6 +42,8 @@ const MARKS: [Marker; 4] = [Marker::Braille, Marker::Dot, Marker::Block, Marker:
 pub struct Series {
     pub name: String,
     pub values: Vec<f64>,
+    /// Threads behind the line.
+    pub threads: usize,
 }
 
 /// What the chart draws for `report`: a line per thread, or, past
@@ -45,9 +52,10 @@ pub fn series(report: &CpuReport) -> Vec<Series> {
     let one = |t: &crate::cpu::ThreadLoad| Series {
         name: t.name.clone(),
         values: t.history.clone(),
+        threads: 1,
     };
     if report.threads.len() <= MAX_LINES {
-        return report.threads.iter().map(one).collect();
+        return ordered(report).into_iter().map(one).collect();
     }
     let (singles, group) = split_group(report);
     let mut out: Vec<Series> = singles.into_iter().map(one).collect();
@@ -72,13 +80,51 @@ pub fn series(report: &CpuReport) -> Vec<Series> {
         out.push(Series {
             name: format!("{prefix}-* mean of {n}"),
             values: mean,
+            threads: n,
         });
         out.push(Series {
             name: format!("{prefix}-* max of {n}"),
             values: max,
+            threads: 0,
         });
     }
     out
+}
+
+/// `series` in at most `styles` lines, so no two look alike: past that,
+/// the last line is the busiest of every thread the dropped lines held.
+pub fn series_in(report: &CpuReport, styles: usize) -> Vec<Series> {
+    let mut all = series(report);
+    if all.len() <= styles || styles < 2 {
+        return all;
+    }
+    let rest = all.split_off(styles - 1);
+    let len = rest.iter().map(|s| s.values.len()).max().unwrap_or(0);
+    let mut max = vec![0.0f64; len];
+    for s in &rest {
+        // Right-aligned: the newest second is last in each.
+        let off = len - s.values.len();
+        for (i, v) in s.values.iter().enumerate() {
+            max[off + i] = max[off + i].max(*v);
+        }
+    }
+    let n: usize = rest.iter().map(|s| s.threads).sum();
+    all.push(Series {
+        name: format!("max of {n} others"),
+        values: max,
+        threads: n,
+    });
+    all
+}
+
+/// The y axis's top: the busiest second drawn, rounded up to 1, 2 or 5
+/// times a power of ten, so a load of a few percent fills the plot.
+pub fn axis_top(lines: &[Series]) -> f64 {
+    let peak = lines
+        .iter()
+        .flat_map(|s| s.values.iter().copied())
+        .fold(1.0, f64::max);
+    nice_ceiling(peak)
 }
 
 pub struct CpuChart<'a> {
@@ -87,11 +133,24 @@ pub struct CpuChart<'a> {
 }
 
 impl CpuChart<'_> {
-    fn style(&self, i: usize) -> (Marker, Style) {
+    /// How many lines this palette can draw with no two alike.
+    pub fn styles(&self) -> usize {
         if self.palette.has_color() {
-            (Marker::Braille, Style::new().fg(COLOURS[i % COLOURS.len()]))
+            COLOURS.len() * MARKS.len()
         } else {
-            (MARKS[i % MARKS.len()], Style::new())
+            MARKS.len()
+        }
+    }
+
+    /// Line `i`'s marker, its legend glyph and its style: a hue each, then
+    /// the next mark; without colour, a mark each.
+    pub fn style(&self, i: usize) -> (Marker, &'static str, Style) {
+        if self.palette.has_color() {
+            let (marker, glyph) = MARKS[(i / COLOURS.len()) % MARKS.len()];
+            (marker, glyph, Style::new().fg(COLOURS[i % COLOURS.len()]))
+        } else {
+            let (marker, glyph) = MARKS[i % MARKS.len()];
+            (marker, glyph, Style::new())
         }
     }
 
@@ -102,13 +161,7 @@ impl CpuChart<'_> {
         let mut row: Vec<Span> = Vec::new();
         let mut used = 0;
         for (i, s) in lines.iter().enumerate() {
-            let (marker, style) = self.style(i);
-            let mark = match marker {
-                Marker::Braille => "━",
-                Marker::Dot => "•",
-                Marker::Block => "█",
-                _ => "▄",
-            };
+            let (_, mark, style) = self.style(i);
             let w = s.name.chars().count() + 4;
             if used > 0 && used + w > width {
                 rows.push(Line::from(std::mem::take(&mut row)));
@@ -127,13 +180,15 @@ impl CpuChart<'_> {
 
 impl Widget for CpuChart<'_> {
     fn render(self, area: Rect, buf: &mut Buffer) {
+        let lines = series_in(self.report, self.styles());
+        // The y axis's labels say the scale (`0 %` … `5 %`).
+        let top = axis_top(&lines);
         // Short enough for the 36 columns the canvas has at 80x24.
         let block = Block::bordered()
             .title(" CPU per thread, last 60 s ")
             .title_bottom(" c: back to the spheres ");
         let inner = block.inner(area);
         block.render(area, buf);
-        let lines = series(self.report);
         let legend = self.legend(&lines, usize::from(inner.width));
         let legend_h = (legend.len() as u16).min(inner.height / 2);
         let [plot, key] =
@@ -150,16 +205,11 @@ impl Widget for CpuChart<'_> {
                     .collect()
             })
             .collect();
-        let peak = lines
-            .iter()
-            .flat_map(|s| s.values.iter().copied())
-            .fold(100.0, f64::max);
-        let top = (peak / 50.0).ceil() * 50.0;
         let datasets: Vec<Dataset> = points
             .iter()
             .enumerate()
             .map(|(i, p)| {
-                let (marker, style) = self.style(i);
+                let (marker, _, style) = self.style(i);
                 Dataset::default()
                     .marker(marker)
                     .graph_type(GraphType::Line)
@@ -222,5 +272,59 @@ mod tests {
         // First second: pool-1..9 only; last: all ten.
         assert_eq!(s[2].values, [5.0, (40.0 + 9.0 * 20.0) / 10.0]);
         assert_eq!(s[3].values, [9.0, 40.0]);
+    }
+
+    fn loaded(percent: f64) -> CpuReport {
+        let mut threads = vec![
+            load(1, "main", vec![percent * 0.2; 60]),
+            load(2, "physics", vec![percent; 60]),
+        ];
+        for (i, name) in ["signals", "input", "output"].iter().enumerate() {
+            threads.push(load(3 + i as i32, name, vec![0.1; 60]));
+        }
+        for i in 0..64 {
+            threads.push(load(100 + i, &format!("pool-{i}"), vec![percent / 2.0; 60]));
+        }
+        CpuReport {
+            threads,
+            cores: 2,
+            ..CpuReport::default()
+        }
+    }
+
+    #[test]
+    fn the_axis_fits_the_load_at_3_and_95_percent() {
+        let c = |p| axis_top(&series(&loaded(p)));
+        // 3 % fills three fifths of a 5 % axis, not the bottom 3 % of 100.
+        assert_eq!(c(3.0), 5.0);
+        assert_eq!(c(95.0), 100.0);
+        assert_eq!(c(0.0), 1.0);
+        assert_eq!(c(130.0), 200.0);
+    }
+
+    #[test]
+    fn no_two_lines_alike_in_16_colours_or_without_colour() {
+        let r = loaded(50.0);
+        for palette in [Palette::C16, Palette::Mono] {
+            let chart = CpuChart {
+                report: &r,
+                palette,
+            };
+            let lines = series_in(&r, chart.styles());
+            // Every thread is behind some line.
+            let n: usize = lines.iter().map(|s| s.threads).sum();
+            assert_eq!(n, r.threads.len(), "{palette:?}");
+            let looks: Vec<(&str, Style)> = (0..lines.len())
+                .map(|i| {
+                    let (_, glyph, style) = chart.style(i);
+                    (glyph, style)
+                })
+                .collect();
+            for (i, a) in looks.iter().enumerate() {
+                for b in &looks[i + 1..] {
+                    assert_ne!(a, b, "{palette:?}: {looks:?}");
+                }
+            }
+        }
     }
 }

@@ -34,6 +34,8 @@ pub enum Action {
     Chart,
     /// Ctrl-Z: give the terminal back and stop (the input thread acts on it).
     Suspend,
+    /// Sort the thread panel by CPU, and back to its fixed order.
+    SortThreads,
 }
 
 /// The key a press means, if any (releases are ignored). The keys are in
@@ -97,6 +99,7 @@ mod tests {
             (KeyCode::Char('f'), Action::SlowerFps),
             (KeyCode::Char('F'), Action::FasterFps),
             (KeyCode::Char('c'), Action::Chart),
+            (KeyCode::Char('s'), Action::SortThreads),
         ];
         for (code, want) in table {
             assert_eq!(action(press(code)), Some(want), "{code:?}");

@@ -121,6 +121,11 @@ pub const TABLE: &[Binding] = &[
         bar: Some(("chart", 4)),
     },
     Binding {
+        presses: &[(K::Char('s'), A::SortThreads)],
+        help: "threads panel: sort by CPU / by role",
+        bar: Some(("sort", 16)),
+    },
+    Binding {
         presses: &[(K::Char('['), A::TickDown), (K::Char(']'), A::TickUp)],
         help: "physics tick - / + (0 freezes)",
         bar: Some(("tick", 7)),

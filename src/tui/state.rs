@@ -32,6 +32,8 @@ pub struct AppState {
     pub help: bool,
     /// The chart of per-thread CPU is shown in place of the canvas.
     pub chart: bool,
+    /// The thread panel is sorted by CPU (busiest first), not by role.
+    pub threads_by_cpu: bool,
     pub fps: f64,
     pub quit: bool,
     /// A limit a key ran into, shown until the next key.
@@ -58,6 +60,7 @@ impl AppState {
             light: 0,
             help: false,
             chart: false,
+            threads_by_cpu: false,
             fps,
             quit: false,
             notice: None,
@@ -193,6 +196,7 @@ impl AppState {
                 }
             }
             Action::Chart => self.chart = !self.chart,
+            Action::SortThreads => self.threads_by_cpu = !self.threads_by_cpu,
             Action::Reset => out.push(Command::Reset),
             Action::Help => self.help = !self.help,
             Action::Suspend => {} // the input thread stops the process

@@ -1,11 +1,14 @@
-//! The thread panel: CPU % per thread (100 % = one core), the process
-//! total and what other processes take. When a row per thread does not fit,
-//! the numbered threads (`pool-0`…) become a grid of cells shaded by load,
-//! as btop shows cores, with their min/mean/max; every other thread keeps
-//! its own figure, so no thread is ever left out.
+//! The thread panel: CPU % per thread (100 % = one core), the pool's own
+//! total, the process total and what other processes take on the same CPUs,
+//! each with its base (`of 200 %` on two cores). Threads come in a fixed
+//! order (main, physics, pool, split, the rest; `cpu::order_key`). Three
+//! layouts, the first that fits: a row per thread with its id on wide panels
+//! and a sparkline; the threads' figures in columns; and only when even those
+//! rows run out, the numbered threads (`pool-0`…) as a grid of cells shaded
+//! by load, as btop shows cores, with a legend. No thread is ever left out.
 use super::theme::Palette;
 use crate::cpu::history;
-use crate::cpu::{CpuReport, ThreadLoad};
+use crate::cpu::{CpuReport, ThreadLoad, order_key};
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
 use ratatui::style::{Color, Style};
@@ -16,20 +19,27 @@ const BARS: [char; 9] = [' ', '▁', '▂', '▃', '▄', '▅', '▆', '▇', '
 const NAME_W: usize = 12;
 /// Cells per block in the grid, a space between blocks so they can be counted.
 const BLOCK: usize = 8;
+/// Inner width from which rows show the thread id (as `top -H` and `perf`).
+pub const TID_WIDTH: usize = 60;
+/// A column entry: an 11-column name, a space, `100.0 %`, a space.
+const ENTRY_W: usize = 20;
 
 pub struct Threads<'a> {
     pub report: &'a CpuReport,
     pub palette: Palette,
+    /// Busiest first (key `s`) instead of the fixed order.
+    pub by_cpu: bool,
 }
 
-/// `values` (percent of one core) as bars, newest last, at most `width`.
-pub fn sparkline(values: &[f64], width: usize) -> String {
+/// `values` (percent of one core) as bars, newest last, at most `width`,
+/// the full bar at `top` percent (see `scale_top`).
+pub fn sparkline(values: &[f64], width: usize, top: f64) -> String {
     let start = values.len().saturating_sub(width);
     let mut s: String = values[start..]
         .iter()
         .map(|v| {
             // Any load at all shows as at least the lowest bar.
-            let level = ((v / 100.0).clamp(0.0, 1.0) * 8.0).round() as usize;
+            let level = ((v / top).clamp(0.0, 1.0) * 8.0).round() as usize;
             BARS[if *v > 0.0 { level.max(1) } else { level }]
         })
         .collect();
@@ -37,6 +47,34 @@ pub fn sparkline(values: &[f64], width: usize) -> String {
     let pad = width.saturating_sub(values.len() - start);
     s.insert_str(0, &" ".repeat(pad));
     s
+}
+
+/// The sparklines' full bar: the busiest second of any thread shown, rounded
+/// up to 1, 2 or 5 times a power of ten (at least 1 %), so a thread at 1 %
+/// and one at 15 % differ in height at any load; the header says the figure.
+pub fn scale_top(report: &CpuReport) -> f64 {
+    let peak = report
+        .threads
+        .iter()
+        .flat_map(|t| t.history.iter().copied().chain([t.percent]))
+        .fold(1.0, f64::max);
+    nice_ceiling(peak)
+}
+
+/// The least of 1, 2 or 5 times a power of ten (from 1) at or above `peak`.
+pub fn nice_ceiling(peak: f64) -> f64 {
+    if !peak.is_finite() {
+        return 100.0;
+    }
+    let mut step = 1.0;
+    loop {
+        for m in [1.0, 2.0, 5.0] {
+            if m * step >= peak {
+                return m * step;
+            }
+        }
+        step *= 10.0;
+    }
 }
 
 /// A grid cell for a load: a dot when idle, else a bar of its height.
@@ -49,9 +87,16 @@ pub fn cell(percent: f64) -> char {
     }
 }
 
-/// The numbered group (`pool-N`) with the most members, if it has two or
-/// more, sorted by number; and every thread not in it, in report order.
-pub fn split_group(report: &CpuReport) -> (Vec<&ThreadLoad>, Option<(String, Vec<&ThreadLoad>)>) {
+/// The grid's legend, the levels `cell` draws.
+pub const LEGEND: &str = "· idle  ▁ under 19 %  ▄ 50 %  █ 100 %";
+
+/// The numbered group (`pool-N`) with the most members, if it has
+/// `min_members` or more, sorted by number; and every other thread, in
+/// report order.
+pub fn group_of(
+    report: &CpuReport,
+    min_members: usize,
+) -> (Vec<&ThreadLoad>, Option<(String, Vec<&ThreadLoad>)>) {
     // `pool-12` -> ("pool", 12); no allocation, as this runs every frame.
     fn numbered(t: &ThreadLoad) -> Option<(&str, u32)> {
         let (prefix, n) = t.name.rsplit_once('-')?;
@@ -66,13 +111,16 @@ pub fn split_group(report: &CpuReport) -> (Vec<&ThreadLoad>, Option<(String, Vec
             }
         }
     }
-    let best = counts.into_iter().filter(|c| c.1 >= 2).max_by_key(|c| c.1);
+    let best = counts
+        .into_iter()
+        .filter(|c| c.1 >= min_members)
+        .max_by_key(|c| c.1);
     let Some((prefix, _)) = best else {
-        return (report.threads.iter().collect(), None);
+        return (ordered(report), None);
     };
     let mut members: Vec<(u32, &ThreadLoad)> = Vec::new();
     let mut singles: Vec<&ThreadLoad> = Vec::new();
-    for t in &report.threads {
+    for t in ordered(report) {
         match numbered(t) {
             Some((p, n)) if p == prefix => members.push((n, t)),
             _ => singles.push(t),
@@ -83,23 +131,46 @@ pub fn split_group(report: &CpuReport) -> (Vec<&ThreadLoad>, Option<(String, Vec
     (singles, Some((prefix.to_string(), members)))
 }
 
-/// Panel rows (border included) for one row per thread.
-pub fn full_height(report: &CpuReport) -> u16 {
-    // Header, the threads, total, others, border.
-    report.threads.len().max(1) as u16 + 5
+/// The report's threads in the order the panel shows them (the sampler
+/// gives them so; a report built elsewhere is put in order here).
+pub fn ordered(report: &CpuReport) -> Vec<&ThreadLoad> {
+    let mut all: Vec<&ThreadLoad> = report.threads.iter().collect();
+    all.sort_by(|a, b| order_key(a).cmp(&order_key(b)));
+    all
 }
 
-/// Panel rows (border included) for the compact view with a cell per
-/// thread, at `inner_width` columns.
+/// `group_of` with two members at least: a group worth a grid or a mean.
+pub fn split_group(report: &CpuReport) -> (Vec<&ThreadLoad>, Option<(String, Vec<&ThreadLoad>)>) {
+    group_of(report, 2)
+}
+
+/// Panel rows (border included) for one row per thread.
+pub fn full_height(report: &CpuReport) -> u16 {
+    let t = Threads {
+        report,
+        palette: Palette::Mono,
+        by_cpu: false,
+    };
+    t.lines(usize::from(u16::MAX)).len() as u16 + 2
+}
+
+/// Panel rows (border included) for the grid with a cell per thread, at
+/// `inner_width` columns: the least the panel needs to show every thread.
 pub fn compact_height(report: &CpuReport, inner_width: usize) -> u16 {
-    let (singles, group) = split_group(report);
-    let group_rows = group.map_or(0, |(_, m)| {
-        let loads = vec![0.0; m.len()];
-        1 + grid(&loads, inner_width, usize::MAX).1.len()
-    });
-    // The totals take one row, two on narrow panels: count two.
-    // An empty report still takes a row to say so.
-    (singles.len().div_ceil(2).max(1) + group_rows + 2 + 2) as u16
+    let t = Threads {
+        report,
+        palette: Palette::Mono,
+        by_cpu: false,
+    };
+    t.compact_lines(inner_width, usize::MAX).len() as u16 + 2
+}
+
+/// Which layout the panel takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layout {
+    Rows,
+    Columns,
+    Grid,
 }
 
 impl Threads<'_> {
@@ -117,78 +188,169 @@ impl Threads<'_> {
         Style::new().fg(c)
     }
 
+    /// `threads` busiest first when sorting by CPU (ties in the fixed order).
+    fn sorted<'t>(&self, mut threads: Vec<&'t ThreadLoad>) -> Vec<&'t ThreadLoad> {
+        if self.by_cpu {
+            threads.sort_by(|a, b| b.percent.total_cmp(&a.percent));
+        }
+        threads
+    }
+
+    /// `of 200 %`: what 100 % of every CPU this process may use adds up to.
+    fn base(&self) -> String {
+        format!("of {} %", self.report.cores * 100)
+    }
+
     fn others(&self) -> String {
         self.report
             .others_percent
             .map_or_else(|| "-".into(), |o| format!("{o:.1}"))
     }
 
-    /// A row per thread with a sparkline of its last seconds.
+    /// The pool's own total (the numbered group, even of one thread): its
+    /// label and its figure.
+    fn group_total(&self) -> Option<(String, String)> {
+        let (_, group) = group_of(self.report, 1);
+        let (prefix, members) = group?;
+        let sum: f64 = members.iter().map(|t| t.percent).sum();
+        let n = members.len();
+        let threads = if n == 1 { "thread" } else { "threads" };
+        Some((
+            format!("{prefix} total"),
+            format!("{sum:>5.1} % of {n} {threads}"),
+        ))
+    }
+
+    /// The process total and the others, on one line if `width` allows.
+    fn totals(&self, width: usize) -> Vec<String> {
+        let base = self.base();
+        let process = format!("process {:.1} % {base}", self.report.total_percent);
+        // Two words, so no reader of the screen takes it for a thread.
+        let others = format!("other procs {} % {base}", self.others());
+        if process.len() + 2 + others.len() <= width {
+            vec![format!("{process}  {others}")]
+        } else {
+            vec![process, others]
+        }
+    }
+
+    /// The layout for an inner area of `width` x `height`.
+    pub fn layout(&self, width: usize, height: usize) -> Layout {
+        if self.lines(width).len() <= height {
+            Layout::Rows
+        } else if self.column_lines(width).len() <= height {
+            Layout::Columns
+        } else {
+            Layout::Grid
+        }
+    }
+
+    /// A row per thread with a sparkline of its last seconds (and its id
+    /// from `TID_WIDTH` columns).
     pub fn lines(&self, width: usize) -> Vec<Line<'static>> {
         let label = self.palette.label();
-        let spark_w = width.saturating_sub(NAME_W + 10).min(history::LEN);
+        let tid = width >= TID_WIDTH;
+        let fixed = NAME_W + 10 + if tid { 8 } else { 0 };
+        let spark_w = width.saturating_sub(fixed).min(history::LEN);
+        let top = scale_top(self.report);
+        let tid_head = if tid {
+            format!(" {:>7}", "TID")
+        } else {
+            String::new()
+        };
         let mut lines = vec![Line::from(Span::styled(
-            format!("{:<NAME_W$} {:>6}  last {spark_w} s", "thread", "CPU %"),
+            format!(
+                "{:<NAME_W$}{tid_head}   CPU %  last {spark_w} s to {top} %",
+                "thread"
+            ),
             label,
         ))];
         if self.report.threads.is_empty() {
             lines.push(Line::from("(no per-thread figures yet)"));
         }
-        for t in &self.report.threads {
+        for t in self.sorted(ordered(self.report)) {
+            let id = if tid {
+                format!(" {:>7}", t.tid)
+            } else {
+                String::new()
+            };
             lines.push(Line::from(vec![
-                Span::raw(format!("{} {:>6.1}  ", padded(&t.name, NAME_W), t.percent)),
-                Span::styled(sparkline(&t.history, spark_w), self.load_style(0.0)),
+                Span::raw(format!(
+                    "{}{id} {:>5.1} %  ",
+                    padded(&t.name, NAME_W),
+                    t.percent
+                )),
+                Span::styled(sparkline(&t.history, spark_w, top), self.load_style(0.0)),
             ]));
         }
-        lines.push(Line::from(Span::styled(
-            format!(
-                "{:<NAME_W$} {:>6.1}  of {} cores",
-                "total", self.report.total_percent, self.report.cores
-            ),
-            label,
-        )));
-        lines.push(Line::from(Span::styled(
-            // Two words, so no reader of the screen takes it for a thread.
-            format!(
-                "{:<NAME_W$} {:>6}  rest of the machine",
-                "other procs",
-                self.others()
-            ),
-            label,
-        )));
+        let row = |l: &str, v: String| {
+            let blank = if tid { " ".repeat(8) } else { String::new() };
+            Line::from(Span::styled(format!("{l:<NAME_W$}{blank} {v}"), label))
+        };
+        if let Some((l, v)) = self.group_total() {
+            lines.push(row(&l, v));
+        }
+        let base = self.base();
+        lines.push(row(
+            "process",
+            format!("{:>5.1} % {base}", self.report.total_percent),
+        ));
+        lines.push(row("other procs", format!("{:>5} % {base}", self.others())));
         lines
     }
 
-    /// Two threads to a row, the numbered group as a grid that fits in
-    /// `height` rows (several threads to a cell, their max, if it must).
+    /// `threads` as `name  8.6 %` entries, as many columns as `width` holds.
+    fn columns(threads: &[&ThreadLoad], width: usize) -> Vec<Line<'static>> {
+        let per_row = ((width + 1) / ENTRY_W).max(1);
+        threads
+            .chunks(per_row)
+            .map(|row| {
+                let text: Vec<String> = row
+                    .iter()
+                    .map(|t| format!("{} {:>5.1} %", padded(&t.name, 11), t.percent))
+                    .collect();
+                Line::from(text.join(" "))
+            })
+            .collect()
+    }
+
+    /// Every thread's figure in columns, the pool total and the totals.
+    pub fn column_lines(&self, width: usize) -> Vec<Line<'static>> {
+        let label = self.palette.label();
+        let all = self.sorted(ordered(self.report));
+        let mut lines = Self::columns(&all, width);
+        if all.is_empty() {
+            lines.push(Line::from("(no per-thread figures yet)"));
+        }
+        lines.extend(
+            self.group_total()
+                .map(|(l, v)| Line::from(Span::styled(format!("{l} {}", v.trim_start()), label))),
+        );
+        lines.extend(
+            self.totals(width)
+                .into_iter()
+                .map(|t| Line::from(Span::styled(t, label))),
+        );
+        lines
+    }
+
+    /// The other threads in columns, the numbered group as a grid that fits
+    /// in `height` rows (several threads to a cell, their max, if it must),
+    /// its legend, the pool total and the totals.
     pub fn compact_lines(&self, width: usize, height: usize) -> Vec<Line<'static>> {
         let label = self.palette.label();
         let (singles, group) = split_group(self.report);
-        let mut lines: Vec<Line> = singles
-            .chunks(2)
-            .map(|pair| {
-                let spans: Vec<Span> = pair
-                    .iter()
-                    .map(|t| Span::raw(format!("{} {:>5.1}   ", padded(&t.name, 11), t.percent)))
-                    .collect();
-                Line::from(spans)
-            })
-            .collect();
+        let mut lines = Self::columns(&self.sorted(singles), width);
         if self.report.threads.is_empty() {
             lines.push(Line::from("(no per-thread figures yet)"));
         }
-        let total = format!(
-            "total {:.1} of {} cores",
-            self.report.total_percent, self.report.cores
-        );
-        let others = format!("other procs {}", self.others());
-        let totals = if total.len() + 2 + others.len() <= width {
-            vec![format!("{total}  {others}")]
-        } else {
-            vec![total, others]
-        };
+        let totals = self.totals(width);
         if let Some((prefix, members)) = group {
-            let grid_rows = height.saturating_sub(lines.len() + 1 + totals.len()).max(1);
+            // Summary, pool total and the totals around the grid; the legend
+            // too while two grid rows are left beside it.
+            let around = lines.len() + 2 + totals.len();
+            let legend = height >= around + 3;
+            let grid_rows = height.saturating_sub(around + usize::from(legend)).max(1);
             let loads: Vec<f64> = members.iter().map(|t| t.percent).collect();
             let (min, mean, max) = min_mean_max(&loads);
             let mut grid_at = grid(&loads, width, grid_rows);
@@ -218,6 +380,14 @@ impl Threads<'_> {
                 }
                 lines.push(Line::from(spans));
             }
+            if legend {
+                lines.push(Line::from(Span::styled(LEGEND, label)));
+            }
+            lines.extend(
+                self.group_total().map(|(l, v)| {
+                    Line::from(Span::styled(format!("{l} {}", v.trim_start()), label))
+                }),
+            );
         }
         lines.extend(
             totals
@@ -282,14 +452,19 @@ fn padded(name: &str, w: usize) -> String {
 
 impl Widget for Threads<'_> {
     fn render(self, area: Rect, buf: &mut Buffer) {
-        let block = Block::bordered().title(" threads: CPU %, 100 % = one core ");
+        let title = if self.by_cpu {
+            " threads by CPU %, 100 % = one core "
+        } else {
+            " threads: CPU %, 100 % = one core "
+        };
+        let block = Block::bordered().title(title);
         let inner = block.inner(area);
         block.render(area, buf);
         let (w, h) = (usize::from(inner.width), usize::from(inner.height));
-        let lines = if area.height >= full_height(self.report) {
-            self.lines(w)
-        } else {
-            self.compact_lines(w, h)
+        let lines = match self.layout(w, h) {
+            Layout::Rows => self.lines(w),
+            Layout::Columns => self.column_lines(w),
+            Layout::Grid => self.compact_lines(w, h),
         };
         Paragraph::new(lines).render(inner, buf);
     }
