@@ -14,7 +14,7 @@ use crate::engine::Snapshot;
 use ratatui::Frame;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::text::Line;
-use ratatui::widgets::{Paragraph, Wrap};
+use ratatui::widgets::Paragraph;
 
 pub const MIN_WIDTH: u16 = 72;
 pub const MIN_HEIGHT: u16 = 22;
@@ -81,14 +81,14 @@ fn readouts_height(side: Rect, report: &CpuReport) -> u16 {
 pub fn draw(frame: &mut Frame, raster: &mut Raster, v: &View) {
     let area = frame.area();
     let Some(a) = areas(area, v.report) else {
-        let msg = vec![
-            Line::from(format!("ballpit needs at least {MIN_WIDTH}x{MIN_HEIGHT};")),
-            Line::from(format!("this terminal is {}x{}.", area.width, area.height)),
-            Line::from("q quits."),
-        ];
+        let msg: Vec<Line> =
+            super::caps::size_message(area.width, area.height, (MIN_WIDTH, MIN_HEIGHT))
+                .into_iter()
+                .map(Line::from)
+                .collect();
         let h = (msg.len() as u16).min(area.height);
         let r = Rect::new(area.x, area.y + (area.height - h) / 2, area.width, h);
-        frame.render_widget(Paragraph::new(msg).centered().wrap(Wrap { trim: true }), r);
+        frame.render_widget(Paragraph::new(msg).centered(), r);
         return;
     };
     if v.state.chart {

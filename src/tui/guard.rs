@@ -412,4 +412,37 @@ mod tests {
         closer.join().unwrap();
         assert_eq!(&sink.0.lock()[..], b"frame|restored");
     }
+
+    #[test]
+    fn restore_waits_for_the_answers_owed_and_a_hold_drops_frames() {
+        let latch: &'static Latch = Box::leak(Box::new(Latch::new()));
+        latch.open();
+        let sink = Sink::default();
+        let mut w = Gated::new(sink.clone(), latch);
+        w.write_chunk(b"?frame?", 2).unwrap();
+        assert_eq!(latch.owed(), 2);
+        // The answers arrive 50 ms later, read by another thread.
+        let reader = std::thread::spawn(move || {
+            std::thread::sleep(Duration::from_millis(50));
+            latch.answer();
+            latch.answer();
+        });
+        let s2 = sink.clone();
+        latch.hold(|| s2.0.lock().extend_from_slice(b"|back"));
+        assert_eq!(latch.owed(), 0, "put back before the answers were read");
+        reader.join().unwrap();
+        // Held: frames are dropped, and owe nothing.
+        w.write_chunk(b"dropped", 2).unwrap();
+        assert_eq!(latch.owed(), 0);
+        assert!(latch.reopen(|| sink.0.lock().extend_from_slice(b"|again")));
+        w.write_chunk(b"|next", 0).unwrap();
+        // An answer that never comes: the restore goes on after the limit.
+        w.write_chunk(b"?", 1).unwrap();
+        let t0 = Instant::now();
+        latch.close(|| sink.0.lock().extend_from_slice(b"|closed"));
+        assert!(t0.elapsed() >= DRAIN_WAIT);
+        assert!(w.write_chunk(b"late", 0).is_err());
+        assert!(!latch.reopen(|| sink.0.lock().extend_from_slice(b"never")));
+        assert_eq!(&sink.0.lock()[..], b"?frame?|back|again|next?|closed");
+    }
 }

@@ -7,6 +7,7 @@
 //! something happens, and never busy-waits.
 pub mod app;
 pub mod canvas;
+pub mod caps;
 pub mod chart;
 pub mod guard;
 pub mod help;

@@ -49,6 +49,8 @@ pub struct Lean<W: Write> {
     /// asking the terminal is a round trip whose answer the input thread
     /// would take.
     cursor: Position,
+    /// Colours are written (not for a terminal that has none).
+    colours: bool,
     /// What the terminal's SGR state is known to be.
     fg: Color,
     bg: Color,
@@ -60,10 +62,19 @@ impl<W: Write> Lean<W> {
         Lean {
             inner: CrosstermBackend::new(writer),
             cursor: Position::ORIGIN,
+            colours: true,
             fg: Color::Reset,
             bg: Color::Reset,
             modifier: Modifier::empty(),
         }
+    }
+
+    /// No colour escape ever: the terminal has no colours (attributes such
+    /// as bold and reverse are kept).
+    #[must_use]
+    pub fn without_colours(mut self) -> Lean<W> {
+        self.colours = false;
+        self
     }
 
     /// Back to default colours (before clearing: a cleared screen takes the
@@ -161,19 +172,24 @@ impl<W: Write> Backend for Lean<W> {
                 }
             }
             self.modifier = cell.modifier;
-            if cell.fg != self.fg {
+            let (fg, bg) = if self.colours {
+                (cell.fg, cell.bg)
+            } else {
+                (Color::Reset, Color::Reset)
+            };
+            if fg != self.fg {
                 if !sgr.is_empty() {
                     sgr.push(b';');
                 }
-                push_colour(&mut sgr, cell.fg, 30);
-                self.fg = cell.fg;
+                push_colour(&mut sgr, fg, 30);
+                self.fg = fg;
             }
-            if cell.bg != self.bg {
+            if bg != self.bg {
                 if !sgr.is_empty() {
                     sgr.push(b';');
                 }
-                push_colour(&mut sgr, cell.bg, 40);
-                self.bg = cell.bg;
+                push_colour(&mut sgr, bg, 40);
+                self.bg = bg;
             }
             if !sgr.is_empty() {
                 out.extend_from_slice(b"\x1b[");

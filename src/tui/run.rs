@@ -75,6 +75,7 @@ pub fn run_with(
     let env = |k: &str| std::env::var(k).ok();
     let palette = Palette::resolve(opts.color, &env);
     let detected = Palette::detect(&env);
+    let ascii = !super::caps::utf8_locale(&env);
     // crossterm drops colours itself under NO_COLOR; the resolved palette
     // already says whether there are any (a --color flag overrides NO_COLOR).
     crossterm::style::Colored::set_ansi_color_disabled(!palette.has_color());
@@ -101,6 +102,7 @@ pub fn run_with(
     reader::spawn_input(tx.clone())?;
     let mut result = FrameLoop::new(engine, state, palette, detected, tx).and_then(|mut l| {
         l.after_first_frame = after_first_frame;
+        l.ascii = ascii;
         l.run(&rx)
     });
     // A panic restores the terminal, so the frame loop may stop on a refused
@@ -153,6 +155,8 @@ struct FrameLoop {
     dirty: bool,
     window: Window,
     after_first_frame: Option<AfterFirstFrame>,
+    /// The locale is not UTF-8: every cell is drawn in ASCII.
+    ascii: bool,
     /// Stopped by job control: no physics, no frames, until resumed.
     held: bool,
     /// The frame in flight spanned a stop: its physics time is not load.
@@ -186,7 +190,15 @@ impl FrameLoop {
         let pacer = Pacer::new(Instant::now());
         let sink = Sink::default();
         let (writer, bytes) = Counting::new(sink.clone());
-        let mut terminal = Terminal::new(Lean::new(writer))?;
+        let lean = Lean::new(writer);
+        // A terminal without colours gets no colour escape at all, whatever
+        // a widget asks for.
+        let lean = if palette.has_color() {
+            lean
+        } else {
+            lean.without_colours()
+        };
+        let mut terminal = Terminal::new(lean)?;
         // Not `Terminal::clear`: it asks the terminal for the cursor position,
         // a round trip that a slow link or a dumb pty may never answer.
         Backend::clear(terminal.backend_mut())?;
@@ -224,6 +236,7 @@ impl FrameLoop {
                 ..Window::default()
             },
             after_first_frame: None,
+            ascii: false,
             held: false,
             stopped_mid_frame: false,
         })
@@ -422,7 +435,13 @@ impl FrameLoop {
         };
         let raster = &mut self.raster;
         queue!(self.terminal.backend_mut(), BeginSynchronizedUpdate)?;
-        self.terminal.draw(|f| app::draw(f, raster, &view))?;
+        let ascii = self.ascii;
+        self.terminal.draw(|f| {
+            app::draw(f, raster, &view);
+            if ascii {
+                super::caps::asciify(f.buffer_mut());
+            }
+        })?;
         let backend = self.terminal.backend_mut();
         queue!(backend, EndSynchronizedUpdate)?;
         Backend::flush(backend)?;
