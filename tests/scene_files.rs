@@ -170,3 +170,37 @@ fn an_endless_stream_of_valid_rows_stops_at_the_largest_scene() {
     let _ = writer.wait();
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `bench --scene -` with `stdin`: its exit code and stderr.
+fn bench_stdin(stdin: Stdio) -> (Option<i32>, String) {
+    let out = Command::new(BIN)
+        .args(["bench", "--steps", "1", "--scene", "-"])
+        .stdin(stdin)
+        .output()
+        .unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn a_scene_on_stdin_is_read_within_the_same_bound() {
+    let d = dir("stdin");
+    let csv = d.join("one.csv");
+    std::fs::write(
+        &csv,
+        "x,y,z,vx,vy,vz,radius,mass\n0.5,0.5,0.5,0,0,0,0.1,1\n",
+    )
+    .unwrap();
+    let toml = d.join("one.toml");
+    std::fs::write(&toml, "preset = \"billiards\"\n").unwrap();
+    for f in [&csv, &toml] {
+        let (code, err) = bench_stdin(std::fs::File::open(f).unwrap().into());
+        assert_eq!(code, Some(0), "{}: {err}", f.display());
+    }
+    let (code, err) = bench_stdin(std::fs::File::open("/dev/zero").unwrap().into());
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("is not text"), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}

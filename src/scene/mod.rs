@@ -61,6 +61,13 @@ pub(crate) fn utf8(bytes: Vec<u8>, name: &str) -> Result<String, BadInput> {
     })
 }
 
+/// Whether a scene on stdin is a sphere CSV: its first line is the header.
+fn looks_like_csv(text: &str) -> bool {
+    text.lines()
+        .find(|l| !l.trim().is_empty())
+        .is_some_and(|l| l.trim_start().starts_with('x') && l.contains(','))
+}
+
 /// The 1-based line holding byte `at` of `text`.
 #[allow(clippy::naive_bytecount)] // once per message: no crate for it
 pub(crate) fn line_of(text: &str, at: usize) -> usize {
@@ -94,14 +101,37 @@ pub fn build_world_for(spec: &SceneSpec, model: Option<ModelKind>) -> Result<Wor
         length("--box", size)?;
     }
     let scene = spec.scene.as_deref().unwrap_or("gas");
-    if scene.ends_with(".csv") {
+    // `-`: a CSV or TOML scene on standard input, read within the larger
+    // (CSV) bound; a TOML one must then keep to its own.
+    let stdin = if scene == "-" {
+        Some(bounded::read_text(Path::new("/dev/stdin"), &csv_io::BOUND)?)
+    } else {
+        None
+    };
+    let scene = if stdin.is_some() { "stdin" } else { scene };
+    if scene.ends_with(".csv") || stdin.as_deref().is_some_and(looks_like_csv) {
         if spec.count.is_some() || spec.radius.is_some() || spec.speed.is_some() {
             return bad!("--count, --radius and --speed do not apply to a CSV scene ({scene})");
         }
-        return csv_io::read(Path::new(scene), spec.size.unwrap_or(1.0), overlaps);
+        let size = spec.size.unwrap_or(1.0);
+        return match &stdin {
+            Some(text) => csv_io::parse_with(text, size, scene, overlaps),
+            None => csv_io::read(Path::new(scene), size, overlaps),
+        };
     }
-    let (file, merged) = if scene.ends_with(".toml") {
-        let f = toml_file::read(Path::new(scene))?;
+    let (file, merged) = if scene.ends_with(".toml") || stdin.is_some() {
+        let f = match &stdin {
+            Some(text) if text.len() as u64 > toml_file::BOUND.max_bytes => {
+                return bad!(
+                    "stdin holds {} bytes of TOML; a TOML scene is at most {} bytes ({})",
+                    text.len(),
+                    toml_file::BOUND.max_bytes,
+                    toml_file::BOUND.why
+                );
+            }
+            Some(text) => toml_file::parse(text, scene)?,
+            None => toml_file::read(Path::new(scene))?,
+        };
         let merged = SceneSpec {
             scene: f.preset.clone(),
             count: spec.count.or(f.count),
