@@ -3,7 +3,7 @@
 //! crosses a boundary.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use ballpit::engine::{Command, Engine, Settings, Threading};
-use ballpit::physics::auto::{Summary, Tolerance, choose};
+use ballpit::physics::auto::{Ask, Summary, Tolerance, choose};
 use ballpit::physics::swept::parts;
 use ballpit::physics::{ModelKind, Serial, Sphere, World};
 use ballpit::scene::{SceneSpec, build_world};
@@ -34,30 +34,53 @@ fn tol(t: f64) -> Tolerance {
     Tolerance::new(t).unwrap()
 }
 
-fn chosen(w: &World, dt: f64, t: Tolerance) -> ModelKind {
-    choose(&Summary::of(w), dt, t, parts(&w.spheres, w.size, dt), 0).model
+fn ask(w: &World, dt: f64, tol: Tolerance) -> Ask {
+    Ask {
+        dt,
+        frame: 1,
+        tol,
+        parts: parts(&w.spheres, w.size, dt),
+        floor: 0,
+    }
 }
 
-/// The calibration's verdict on the presets (docs/models.md, "auto"):
-/// `swept` on the fast projectiles at the coarse steps, `exact` elsewhere;
-/// `discrete` never keeps 0.1 of a radius on a preset at these steps.
+fn chosen(w: &World, dt: f64, t: Tolerance) -> ModelKind {
+    let c = choose(&Summary::of(w), ask(w, dt, t));
+    eprintln!("{dt:.2e} {t}: {} ({})", c.model, c.reason);
+    c.model
+}
+
+/// The calibration's verdict on the presets at one step a frame (the
+/// screen's default tick; docs/models.md, "auto"): `exact` on the dense
+/// preset, `swept` where exact's per-frame sync and readout or its cell
+/// crossings cost more; `discrete` never keeps 0.1 of a radius on a preset
+/// at these steps.
 #[test]
 fn the_presets_choose_as_the_table_says() {
     use ModelKind::{Exact as E, Swept as S};
     let table: [(&str, [ModelKind; 3]); 6] = [
-        ("gas", [E, E, E]),
-        ("billiards", [E, E, E]),
+        ("gas", [S, S, S]),
+        ("billiards", [E, S, S]),
         ("dense", [E, E, E]),
-        ("projectiles", [S, S, E]),
-        ("cradle", [E, E, E]),
-        ("mixed", [E, E, E]),
+        ("projectiles", [S, S, S]),
+        ("cradle", [S, S, S]),
+        ("mixed", [E, S, S]),
     ];
-    for (name, want) in table {
-        let w = preset(name);
-        for t in [0.0, 0.01, 0.1] {
-            let got = DTS.map(|dt| chosen(&w, dt, tol(t)));
-            assert_eq!(got, want, "{name} at tolerance {t}");
+    for t in [0.0, 0.01, 0.1] {
+        let got: Vec<_> = table
+            .iter()
+            .map(|(name, _)| (*name, DTS.map(|dt| chosen(&preset(name), dt, tol(t)))))
+            .collect();
+        let mut want = table.to_vec();
+        if t >= 0.1 {
+            // At the fine step the slow presets sink at most a few
+            // hundredths of a radius: `discrete` keeps 0.1 (dense measured
+            // 0.017 over 2 s, docs/models.md).
+            for row in [1, 2, 4] {
+                want[row].1[2] = ModelKind::Discrete;
+            }
         }
+        assert_eq!(got, want, "tolerance {t}");
     }
 }
 
@@ -69,7 +92,7 @@ fn an_impossible_scene_takes_exact_and_says_so() {
     for s in &mut w.spheres {
         s.vel *= 2e4;
     }
-    let c = choose(&Summary::of(&w), 1.0 / 15.0, tol(0.0), 1, 0);
+    let c = choose(&Summary::of(&w), ask(&w, 1.0 / 15.0, tol(0.0)));
     assert_eq!(c.model, ModelKind::Exact);
     assert!(c.unmet);
     assert!(c.reason.contains("cannot be met"), "{}", c.reason);

@@ -8,14 +8,17 @@ use crate::physics::model::ModelKind;
 use crate::physics::world::World;
 use std::f64::consts::PI;
 
-/// Predicted cost of one `exact` event (contact, wall or cell crossing)
-/// and of syncing one sphere per step, in seconds (calibrated on the
-/// default scene's tradeoff rows, docs/models.md).
-const EXACT_EVENT: f64 = 3.4e-7;
-const EXACT_SPHERE_STEP: f64 = 9.8e-9;
-/// `swept`: one sphere in one part of a step, and one contact or wall hit.
-const SWEPT_SPHERE_STEP: f64 = 3.8e-8;
-const SWEPT_EVENT: f64 = 1.35e-6;
+/// Predicted cost of one `exact` event (contact, wall or cell crossing),
+/// of a sphere in a step, and of a sphere in a frame (the sync on return
+/// and the overlap readout), in seconds: fitted to `ballpit bench` on the
+/// gas preset at three dt (docs/models.md, "auto").
+const EXACT_EVENT: f64 = 4.4e-7;
+const EXACT_SPHERE_STEP: f64 = 1.8e-9;
+const EXACT_SPHERE_FRAME: f64 = 5.4e-8;
+/// `swept`: one sphere in one part of a step, and one contact or wall hit
+/// (its overlap readout is the next step's detection, reused).
+const SWEPT_SPHERE_STEP: f64 = 3.5e-8;
+const SWEPT_EVENT: f64 = 1.5e-6;
 /// `discrete`: one sphere in one step (move, grid, overlaps).
 const DISCRETE_SPHERE_STEP: f64 = 3.4e-8;
 /// `swept` is taken over `exact` only when predicted this much cheaper:
@@ -130,14 +133,18 @@ pub struct Costs {
     pub exact: f64,
 }
 
-pub fn costs(s: &Summary, dt: f64, swept_parts: u32) -> Costs {
+/// `frame`: steps per `advance` (the tick), each call ending in a sync.
+pub fn costs(s: &Summary, dt: f64, swept_parts: u32, frame: u64) -> Costs {
     let r = rates(s);
     let steps = s.count as f64 / dt;
+    let frames = steps / frame.max(1) as f64;
     Costs {
         discrete: DISCRETE_SPHERE_STEP * steps,
         swept: SWEPT_SPHERE_STEP * steps * f64::from(swept_parts.max(1))
             + SWEPT_EVENT * (r.contacts + r.walls),
-        exact: EXACT_EVENT * (r.contacts + r.walls + r.crossings) + EXACT_SPHERE_STEP * steps,
+        exact: EXACT_EVENT * (r.contacts + r.walls + r.crossings)
+            + EXACT_SPHERE_STEP * steps
+            + EXACT_SPHERE_FRAME * frames,
     }
 }
 
@@ -160,11 +167,29 @@ fn ratio(a: f64, b: f64) -> String {
     }
 }
 
-/// The cheapest model predicted to keep `tol` (`strict`: the models the
-/// run has already seen break it are out, stricter ones only).
-pub fn choose(s: &Summary, dt: f64, tol: Tolerance, swept_parts: u32, floor: u8) -> Choice {
+/// How `choose` is asked: `dt`, steps per frame, the tolerance, `swept`'s
+/// parts for this scene, and the strictness floor (1: no `discrete`, 2:
+/// `exact` only, once the cheaper ones broke the tolerance).
+#[derive(Clone, Copy, Debug)]
+pub struct Ask {
+    pub dt: f64,
+    pub frame: u64,
+    pub tol: Tolerance,
+    pub parts: u32,
+    pub floor: u8,
+}
+
+/// The cheapest model predicted to keep the tolerance.
+pub fn choose(s: &Summary, ask: Ask) -> Choice {
+    let Ask {
+        dt,
+        frame,
+        tol,
+        parts: swept_parts,
+        floor,
+    } = ask;
     let t = tol.fraction();
-    let c = costs(s, dt, swept_parts);
+    let c = costs(s, dt, swept_parts, frame);
     let r = rates(s);
     let per_step = (r.contacts + r.walls + r.crossings) * dt;
     let exact_cap = (EVENT_CAP_BASE + EVENT_CAP_PER_SPHERE * s.count as u64) as f64;
@@ -193,10 +218,13 @@ pub fn choose(s: &Summary, dt: f64, tol: Tolerance, swept_parts: u32, floor: u8)
     }
     let swept_fits = r.contacts.max(0.0) * dt / f64::from(swept_parts.max(1)) < swept_cap;
     if floor <= 1 && swept_fits && c.swept * SWEPT_MARGIN < c.exact {
-        let why = if r.crossings > r.contacts + r.walls {
-            "fast"
+        let frames = EXACT_SPHERE_FRAME * s.count as f64 / (dt * frame.max(1) as f64);
+        let why = if frames > 0.5 * c.exact {
+            format!("{frame} step a frame")
+        } else if r.crossings > r.contacts + r.walls {
+            "fast".to_string()
         } else {
-            "coarse dt"
+            "coarse dt".to_string()
         };
         return Choice {
             model: ModelKind::Swept,
@@ -207,7 +235,7 @@ pub fn choose(s: &Summary, dt: f64, tol: Tolerance, swept_parts: u32, floor: u8)
             unmet: false,
         };
     }
-    let why = if floor >= 2 {
+    let why = if floor >= 2 && c.swept * SWEPT_MARGIN < c.exact {
         "the cheaper models broke the tolerance".to_string()
     } else if s.packing > 0.3 {
         format!("dense: {} cheaper than swept", ratio(c.swept, c.exact))

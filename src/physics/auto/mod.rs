@@ -5,7 +5,7 @@
 //! stricter models are let in until the scene changes).
 mod choose;
 
-pub use choose::{Choice, Costs, Rates, Summary, choose, costs, discrete_overlap, rates};
+pub use choose::{Ask, Choice, Costs, Rates, Summary, choose, costs, discrete_overlap, rates};
 
 use super::exec::Exec;
 use super::model::{Model, ModelKind};
@@ -73,9 +73,9 @@ fn level(m: ModelKind) -> u8 {
     }
 }
 
-/// What the choice was made for: the spheres' edit generation, their count
-/// and `dt`.
-type Key = (u64, usize, u64);
+/// What the choice was made for: the spheres' edit generation, their
+/// count, `dt` and the steps per frame.
+type Key = (u64, usize, u64, u64);
 
 pub struct Auto {
     tol: Tolerance,
@@ -103,10 +103,16 @@ impl Auto {
         }
     }
 
-    fn rechoose(&mut self, world: &World, dt: f64) {
+    fn rechoose(&mut self, world: &World, dt: f64, frame: u64) {
         let summary = Summary::of(world);
-        let parts = super::swept::parts(&world.spheres, world.size, dt);
-        let mut c = choose(&summary, dt, self.tol, parts, self.floor);
+        let ask = Ask {
+            dt,
+            frame,
+            tol: self.tol,
+            parts: super::swept::parts(&world.spheres, world.size, dt),
+            floor: self.floor,
+        };
+        let mut c = choose(&summary, ask);
         if let Some(b) = &self.broke {
             c.reason = format!("{b}: stricter; {}", c.reason);
         }
@@ -135,7 +141,7 @@ impl Model for Auto {
     }
 
     fn advance(&mut self, world: &mut World, dt: f64, steps: u64, exec: &dyn Exec) {
-        let key = (world.generation(), world.spheres.len(), dt.to_bits());
+        let key = (world.generation(), world.spheres.len(), dt.to_bits(), steps);
         if self.key != Some(key) {
             self.key = Some(key);
             self.floor = 0;
@@ -143,7 +149,7 @@ impl Model for Auto {
             self.again = true;
         }
         if self.again {
-            self.rechoose(world, dt);
+            self.rechoose(world, dt, steps);
         }
         let capped = world.counters.capped_steps;
         self.inner.advance(world, dt, steps, exec);
