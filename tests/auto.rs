@@ -41,6 +41,7 @@ fn ask(w: &World, dt: f64, tol: Tolerance) -> Ask {
         tol,
         parts: parts(&w.spheres, w.size, dt),
         floor: 0,
+        readouts: true,
     }
 }
 

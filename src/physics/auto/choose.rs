@@ -9,12 +9,14 @@ use crate::physics::world::World;
 use std::f64::consts::PI;
 
 /// Predicted cost of one `exact` event (contact, wall or cell crossing),
-/// of a sphere in a step, and of a sphere in a frame (the sync on return
-/// and the overlap readout), in seconds: fitted to `ballpit bench` on the
-/// gas preset at three dt (docs/models.md, "auto").
+/// of a sphere in a step, of a sphere's sync at the end of an `advance`,
+/// and of a sphere in the overlap readout the engine asks for each frame,
+/// in seconds: fitted to `ballpit bench` and `ballpit tradeoff` on the gas
+/// preset (docs/models.md, "auto").
 const EXACT_EVENT: f64 = 4.4e-7;
 const EXACT_SPHERE_STEP: f64 = 1.8e-9;
-const EXACT_SPHERE_FRAME: f64 = 5.4e-8;
+const EXACT_SPHERE_SYNC: f64 = 1.1e-8;
+const EXACT_SPHERE_READOUT: f64 = 4.3e-8;
 /// `swept`: one sphere in one part of a step, and one contact or wall hit
 /// (its overlap readout is the next step's detection, reused).
 const SWEPT_SPHERE_STEP: f64 = 3.5e-8;
@@ -133,18 +135,20 @@ pub struct Costs {
     pub exact: f64,
 }
 
-/// `frame`: steps per `advance` (the tick), each call ending in a sync.
-pub fn costs(s: &Summary, dt: f64, swept_parts: u32, frame: u64) -> Costs {
+/// `frame`: steps per `advance` (the tick), each call ending in a sync,
+/// and in an overlap readout if `readouts`.
+pub fn costs(s: &Summary, dt: f64, swept_parts: u32, frame: u64, readouts: bool) -> Costs {
     let r = rates(s);
     let steps = s.count as f64 / dt;
     let frames = steps / frame.max(1) as f64;
+    let per_frame = EXACT_SPHERE_SYNC + if readouts { EXACT_SPHERE_READOUT } else { 0.0 };
     Costs {
         discrete: DISCRETE_SPHERE_STEP * steps,
         swept: SWEPT_SPHERE_STEP * steps * f64::from(swept_parts.max(1))
             + SWEPT_EVENT * (r.contacts + r.walls),
         exact: EXACT_EVENT * (r.contacts + r.walls + r.crossings)
             + EXACT_SPHERE_STEP * steps
-            + EXACT_SPHERE_FRAME * frames,
+            + per_frame * frames,
     }
 }
 
@@ -177,6 +181,9 @@ pub struct Ask {
     pub tol: Tolerance,
     pub parts: u32,
     pub floor: u8,
+    /// The caller reads the deepest overlap after every `advance` (the
+    /// engine does; `tradeoff` does not).
+    pub readouts: bool,
 }
 
 /// The cheapest model predicted to keep the tolerance.
@@ -187,9 +194,10 @@ pub fn choose(s: &Summary, ask: Ask) -> Choice {
         tol,
         parts: swept_parts,
         floor,
+        readouts,
     } = ask;
     let t = tol.fraction();
-    let c = costs(s, dt, swept_parts, frame);
+    let c = costs(s, dt, swept_parts, frame, readouts);
     let r = rates(s);
     let per_step = (r.contacts + r.walls + r.crossings) * dt;
     let exact_cap = (EVENT_CAP_BASE + EVENT_CAP_PER_SPHERE * s.count as u64) as f64;
@@ -218,7 +226,8 @@ pub fn choose(s: &Summary, ask: Ask) -> Choice {
     }
     let swept_fits = r.contacts.max(0.0) * dt / f64::from(swept_parts.max(1)) < swept_cap;
     if floor <= 1 && swept_fits && c.swept * SWEPT_MARGIN < c.exact {
-        let frames = EXACT_SPHERE_FRAME * s.count as f64 / (dt * frame.max(1) as f64);
+        let frames = (EXACT_SPHERE_SYNC + EXACT_SPHERE_READOUT) * s.count as f64
+            / (dt * frame.max(1) as f64);
         let why = if frames > 0.5 * c.exact {
             format!("{frame} step a frame")
         } else if r.crossings > r.contacts + r.walls {

@@ -74,8 +74,8 @@ fn level(m: ModelKind) -> u8 {
 }
 
 /// What the choice was made for: the spheres' edit generation, their
-/// count, `dt` and the steps per frame.
-type Key = (u64, usize, u64, u64);
+/// count, `dt`, the steps per frame and whether overlaps are read.
+type Key = (u64, usize, u64, u64, bool);
 
 pub struct Auto {
     tol: Tolerance,
@@ -88,6 +88,10 @@ pub struct Auto {
     broke: Option<String>,
     /// The choice is to be made again at the next `advance`.
     again: bool,
+    /// Whether the caller reads the overlap after each `advance`: assumed
+    /// (the engine does) until an `advance` follows one without a readout.
+    readouts: bool,
+    read_since: bool,
 }
 
 impl Auto {
@@ -100,6 +104,8 @@ impl Auto {
             floor: 0,
             broke: None,
             again: true,
+            readouts: true,
+            read_since: true,
         }
     }
 
@@ -111,6 +117,7 @@ impl Auto {
             tol: self.tol,
             parts: super::swept::parts(&world.spheres, world.size, dt),
             floor: self.floor,
+            readouts: self.readouts,
         };
         let mut c = choose(&summary, ask);
         if let Some(b) = &self.broke {
@@ -141,7 +148,15 @@ impl Model for Auto {
     }
 
     fn advance(&mut self, world: &mut World, dt: f64, steps: u64, exec: &dyn Exec) {
-        let key = (world.generation(), world.spheres.len(), dt.to_bits(), steps);
+        self.readouts = self.read_since;
+        self.read_since = false;
+        let key = (
+            world.generation(),
+            world.spheres.len(),
+            dt.to_bits(),
+            steps,
+            self.readouts,
+        );
         if self.key != Some(key) {
             self.key = Some(key);
             self.floor = 0;
@@ -171,6 +186,7 @@ impl Model for Auto {
     /// check its promise, so it measures it then (a grid pass, as the
     /// engine's own would be).
     fn max_overlap_rel(&mut self, world: &World, dt: f64, exec: &dyn Exec) -> Option<f64> {
+        self.read_since = true;
         let depth = if self.inner.kind() == ModelKind::Discrete {
             Some(world.max_overlap_rel())
         } else {
