@@ -329,3 +329,51 @@ fn the_tolerance_flag_is_checked_and_reported() {
     let v = json(&["bench", "--model", "swept", "--steps", "2"]);
     assert!(v["model_chosen"].is_null());
 }
+
+/// The readouts' model row names what `auto` runs (its reason follows as
+/// far as the panel is wide).
+#[test]
+fn the_model_row_says_what_auto_runs() {
+    use ballpit::tui::readouts::{Readouts, Stats};
+    use ballpit::tui::state::AppState;
+    use ballpit::tui::theme::Palette;
+    let s = settings(ModelKind::Auto(tol(0.0)), Threading::Off, 1.0 / 60.0);
+    let mut e = Engine::new(preset("dense"), s).unwrap();
+    e.start_frame().unwrap();
+    let snap = e.finish_frame().unwrap().clone();
+    let st = AppState::new(&s, snap.count, 0.0363, 30.0);
+    let stats = Stats {
+        fps: 30.0,
+        physics_seconds: snap.physics_seconds,
+        render_seconds: 0.001,
+        frame_bytes: 1000,
+        steps_per_second: 30.0,
+        collisions_per_second: 1.0,
+        detected: Some(Palette::True),
+        link: None,
+        link_slow: false,
+    };
+    let mut t = ratatui::Terminal::new(ratatui::backend::TestBackend::new(
+        72,
+        ballpit::tui::readouts::HEIGHT,
+    ))
+    .unwrap();
+    t.draw(|f| {
+        f.render_widget(
+            Readouts {
+                state: &st,
+                snap: &snap,
+                stats: &stats,
+                palette: Palette::C16,
+            },
+            f.area(),
+        );
+    })
+    .unwrap();
+    let buf = t.backend().buffer();
+    let text: Vec<String> = (0..buf.area.height)
+        .map(|y| (0..buf.area.width).map(|x| buf[(x, y)].symbol()).collect())
+        .collect();
+    let row = text.iter().find(|r| r.contains("model")).unwrap();
+    assert!(row.contains("auto → exact (dense:"), "{text:#?}");
+}
