@@ -19,6 +19,12 @@ pub struct BenchReport {
     pub steps: u64,
     pub dt: f64,
     pub model: String,
+    /// What `auto` chose to run at the end and why (null for the others).
+    pub model_chosen: Option<String>,
+    pub model_reason: Option<String>,
+    /// Not in the JSON: `auto` could not meet its tolerance (in `warnings`).
+    #[serde(skip)]
+    pub tolerance_unmet: bool,
     pub threading: String,
     pub threads: usize,
     /// The threads the physics really ran on (the driver first).
@@ -85,6 +91,12 @@ pub fn warnings(report: &BenchReport) -> Vec<String> {
             crate::physics::discrete::pair_budget(report.n)
         ));
     }
+    if report.tolerance_unmet {
+        w.push(format!(
+            "auto could not meet its tolerance and ran the strictest model: {}",
+            report.model_reason.as_deref().unwrap_or("")
+        ));
+    }
     if report.escaped > 0 {
         w.push(format!("{} spheres ended outside the cube", report.escaped));
     }
@@ -142,6 +154,7 @@ pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(Ben
     let last = engine.snapshot();
     let (e1, escaped) = (last.energy, last.escaped);
     let (max_overlap_rel, overlap_partial) = (last.max_overlap_rel, last.overlap_partial);
+    let choice = last.choice.clone();
     let world = engine
         .into_world()
         .ok_or_else(|| anyhow::anyhow!("the engine lost its world"))?;
@@ -155,6 +168,9 @@ pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(Ben
         steps,
         dt: settings.dt,
         model: settings.model.name().to_string(),
+        model_chosen: choice.as_ref().map(|c| c.model.name().to_string()),
+        tolerance_unmet: choice.as_ref().is_some_and(|c| c.unmet),
+        model_reason: choice.map(|c| c.reason),
         threading: settings.threading.name().to_string(),
         threads: settings.threads,
         physics_threads,

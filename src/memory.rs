@@ -9,7 +9,8 @@ use crate::physics::ModelKind;
 pub fn sphere_bytes(model: ModelKind) -> u64 {
     match model {
         ModelKind::Discrete => 243,
-        ModelKind::Swept => 285,
+        // `auto` may run any: the hungriest.
+        ModelKind::Swept | ModelKind::Auto(_) => 285,
         ModelKind::Exact => 250,
     }
 }

@@ -24,7 +24,6 @@ use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::path::Path;
 use std::time::Instant;
-use strum::EnumCount;
 
 /// The `dt` ladder: 1/15 s down to 1/1920 s, halving.
 pub const LADDER: [f64; 8] = [
@@ -58,11 +57,13 @@ pub struct Row {
     /// RMS distance to the reference positions at `horizon`, in box lengths.
     pub pos_err: f64,
     pub capped_steps: u64,
+    /// What `auto` ran at the end of the run (`None` for the other models).
+    pub chosen: Option<ModelKind>,
 }
 
 /// The runs [`measure`] makes: the reference over [`RUN_SECONDS`] and to
 /// each dt's horizon, then per model and dt a run and a run to the horizon.
-pub const RUNS: usize = 1 + LADDER.len() + 2 * ModelKind::COUNT * LADDER.len();
+pub const RUNS: usize = 1 + LADDER.len() + 2 * ModelKind::ALL.len() * LADDER.len();
 
 /// Measure every model over the ladder on `world`.
 pub fn measure(world: &World) -> Vec<Row> {
@@ -102,6 +103,7 @@ pub fn measure_with(world: &World, progress: &mut dyn FnMut(usize, &str)) -> Vec
         })
         .collect();
     let mut rows = Vec::new();
+    // `auto` at tolerance 0 beside the three it chooses among.
     for model in ModelKind::ALL {
         for (dt, (steps_h, truth)) in LADDER.into_iter().zip(&at_horizon) {
             next(&format!("{model}, dt {}", dt_label(dt)));
@@ -155,6 +157,7 @@ fn run_one(world: &World, kind: ModelKind, dt: f64) -> Row {
         horizon: 0.0,
         pos_err: 0.0,
         capped_steps: w.counters.capped_steps,
+        chosen: model.choice().map(|c| c.model),
     }
 }
 
@@ -192,7 +195,7 @@ pub fn markdown(rows: &[Row]) -> String {
         let _ = writeln!(
             s,
             "| {} | {} | {:.2e} | {:.2e} | {:.1e} | {:.1e} | {} | {:+.1} % | {:.1e} at {:.3} s |",
-            r.model,
+            model_cell(r),
             dt_label(r.dt),
             r.cost,
             r.sphere_steps_per_second,
@@ -207,8 +210,16 @@ pub fn markdown(rows: &[Row]) -> String {
     s
 }
 
+/// `auto → exact` for `auto`'s rows, the model's name for the others.
+fn model_cell(r: &Row) -> String {
+    match r.chosen {
+        Some(c) => format!("{} → {c}", r.model),
+        None => r.model.to_string(),
+    }
+}
+
 /// The columns of `tradeoff.csv`, in order (`tradeoff --help` lists them).
-pub const CSV_COLUMNS: [&str; 13] = [
+pub const CSV_COLUMNS: [&str; 14] = [
     "model",
     "dt",
     "steps",
@@ -222,6 +233,7 @@ pub const CSV_COLUMNS: [&str; 13] = [
     "horizon_s",
     "pos_err_rms",
     "capped_steps",
+    "chosen",
 ];
 
 /// The rows as CSV. Numbers are in `{:e}` form: one notation for columns
@@ -246,6 +258,7 @@ pub fn csv(rows: &[Row]) -> anyhow::Result<String> {
             e(r.horizon),
             e(r.pos_err),
             r.capped_steps.to_string(),
+            r.chosen.map_or_else(String::new, |c| c.to_string()),
         ];
         w.write_record(&fields)?;
     }
@@ -387,9 +400,10 @@ mod tests {
             horizon: 0.05,
             pos_err: 3e-3,
             capped_steps: 1,
+            chosen: None,
         };
         let text = csv(&[row.clone(), row]).unwrap();
-        let line = "swept,1.6666666666666666e-2,120,5e-1,1.5e6,1e-15,0e0,2,42,-2.5e-1,5e-2,3e-3,1";
+        let line = "swept,1.6666666666666666e-2,120,5e-1,1.5e6,1e-15,0e0,2,42,-2.5e-1,5e-2,3e-3,1,";
         assert_eq!(text, format!("{}\n{line}\n{line}\n", CSV_COLUMNS.join(",")));
     }
 
@@ -408,10 +422,10 @@ mod tests {
         let rows = measure_with(&world, &mut |done, next| {
             seen.push((done, next.to_string()));
         });
-        assert_eq!(rows.len(), ModelKind::COUNT * LADDER.len());
+        assert_eq!(rows.len(), ModelKind::ALL.len() * LADDER.len());
         assert_eq!(seen.len(), RUNS);
         assert!(seen.iter().enumerate().all(|(i, (done, _))| *done == i));
         assert_eq!(seen[0].1, "reference");
-        assert_eq!(seen[RUNS - 1].1, "exact to the horizon, dt 1/1920");
+        assert_eq!(seen[RUNS - 1].1, "auto to the horizon, dt 1/1920");
     }
 }

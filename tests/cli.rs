@@ -154,7 +154,7 @@ fn bad_input_exits_2_with_one_clear_message() {
         ),
         (
             vec!["--model".into(), "magic".into()],
-            "invalid value 'magic' for '--model <MODEL>'\n  [possible values: discrete, swept, exact]",
+            "invalid value 'magic' for '--model <MODEL>'\n  [possible values: discrete, swept, exact, auto]",
         ),
         (
             vec!["--threading".into(), "many".into()],

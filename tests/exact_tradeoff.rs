@@ -152,10 +152,13 @@ fn cli_writes_the_table_the_csv_and_the_plot() {
     let table = String::from_utf8(out.stdout).unwrap();
     // The note naming the reference, a blank line, the header, the rows.
     assert_eq!(table.lines().next(), Some(REFERENCE_NOTE));
-    assert_eq!(table.lines().count(), 4 + 3 * LADDER.len());
+    let models = ModelKind::ALL.len();
+    assert_eq!(table.lines().count(), 4 + models * LADDER.len());
     assert!(table.contains("| exact | 1/1920 |"));
+    // `auto` says what it ran on each row.
+    assert!(table.contains("| auto → "), "{table}");
     let csv = std::fs::read_to_string(dir.join("tradeoff.csv")).unwrap();
-    assert_eq!(csv.lines().count(), 1 + 3 * LADDER.len());
+    assert_eq!(csv.lines().count(), 1 + models * LADDER.len());
     let svg = std::fs::read_to_string(dir.join("tradeoff.svg")).unwrap();
     assert!(svg.starts_with("<svg") && svg.contains("discrete") && svg.contains("exact"));
     let _ = std::fs::remove_dir_all(&dir);

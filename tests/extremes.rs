@@ -68,7 +68,8 @@ fn run(name: &str, kind: ModelKind, world: &World, dt: f64, steps: u64) -> Outco
             let was_capped = w.counters.capped_steps > capped;
             let bound = match kind {
                 ModelKind::Exact => Some(EXACT_OVERLAP),
-                ModelKind::Swept => Some(SWEPT_OVERLAP),
+                // At tolerance 0 `auto` runs `swept` or `exact`.
+                ModelKind::Swept | ModelKind::Auto(_) => Some(SWEPT_OVERLAP),
                 ModelKind::Discrete => None,
             };
             // Every step that was not capped is checked.

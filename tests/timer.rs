@@ -26,7 +26,7 @@ fn scene(model: ModelKind) -> World {
             count: Some(8000),
             ..Default::default()
         },
-        ModelKind::Swept | ModelKind::Exact => SceneSpec {
+        ModelKind::Swept | ModelKind::Exact | ModelKind::Auto(_) => SceneSpec {
             scene: Some("gas".into()),
             count: Some(10_000),
             radius: Some(0.005),

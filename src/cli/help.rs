@@ -12,6 +12,14 @@ pub const BENCH_FIELDS: &[(&str, &str)] = &[
     ("steps", "steps run"),
     ("dt", "step length, s"),
     ("model", "collision model"),
+    (
+        "model_chosen",
+        "what --model auto ran at the end (null for the others)",
+    ),
+    (
+        "model_reason",
+        "why auto chose it, or that the tolerance could not be met",
+    ),
     ("threading", "threading mode"),
     ("threads", "pool threads (--threads)"),
     (

@@ -12,6 +12,8 @@ pub use values::{ColorArg, ModelArg, ThreadingArg};
 use crate::bad;
 use crate::engine::{MAX_THREADS, Settings, default_threads};
 use crate::error::BadInput;
+use crate::physics::ModelKind;
+use crate::physics::auto::Tolerance;
 use crate::scene::SceneSpec;
 use clap::builder::RangedU64ValueParser;
 use clap::parser::ValueSource;
@@ -134,6 +136,10 @@ pub struct RunArgs {
     /// Collision model
     #[arg(long, value_enum, default_value_t = ModelArg::Swept, value_name = "MODEL")]
     pub model: ModelArg,
+    /// For --model auto: the fraction of the smaller radius by which spheres
+    /// may sink into each other, 0 to 1 [default: 0, contacts exact]
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    pub tolerance: Option<f64>,
     /// Where the physics runs
     #[arg(long, value_enum, default_value_t = ThreadingArg::Off, value_name = "MODE")]
     pub threading: ThreadingArg,
@@ -257,8 +263,23 @@ impl RunArgs {
             return bad!("--dt must be a finite number > 0, got {}", self.dt);
         }
         let threads = self.threads.unwrap_or_else(default_threads);
+        let mut model: ModelKind = self.model.into();
+        if let Some(t) = self.tolerance {
+            let Some(tol) = Tolerance::new(t) else {
+                return bad!(
+                    "--tolerance must be a fraction of the smaller radius from 0 to 1, got {t}"
+                );
+            };
+            if model.tolerance().is_some() {
+                model = ModelKind::Auto(tol);
+            } else {
+                eprintln!(
+                    "ballpit: warning: --tolerance only steers --model auto; {model} ignores it"
+                );
+            }
+        }
         Ok(Settings {
-            model: self.model.into(),
+            model,
             dt: self.dt,
             tick: self.tick.unwrap_or(1),
             threading: self.threading.into(),

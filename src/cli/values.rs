@@ -15,6 +15,8 @@ pub enum ModelArg {
     Swept,
     /// Event-driven, every collision in time order; dt only samples
     Exact,
+    /// The cheapest of the three that keeps --tolerance, chosen per scene
+    Auto,
 }
 
 impl From<ModelArg> for ModelKind {
@@ -23,6 +25,7 @@ impl From<ModelArg> for ModelKind {
             ModelArg::Discrete => ModelKind::Discrete,
             ModelArg::Swept => ModelKind::Swept,
             ModelArg::Exact => ModelKind::Exact,
+            ModelArg::Auto => ModelKind::Auto(crate::physics::auto::Tolerance::EXACT),
         }
     }
 }

@@ -87,6 +87,7 @@ impl Frame {
         snap.physics_seconds = physics_seconds;
         snap.steps = steps;
         snap.settings = self.settings;
+        snap.choice = self.model.choice().cloned();
         snap.notice.clone_from(&self.notice);
     }
 }

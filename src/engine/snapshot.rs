@@ -1,6 +1,7 @@
 //! What the screen reads of a finished frame. Two of them exist: the front
 //! one the renderer reads while the physics fills the back one.
 use super::Settings;
+use crate::physics::auto::Choice;
 use crate::physics::broad::Grid;
 use crate::physics::discrete::pair_budget;
 use crate::physics::exec::{for_each_block, for_each_chunk};
@@ -45,6 +46,8 @@ pub struct Snapshot {
     pub counters: Counters,
     /// Parts the model cut its last step into (1: whole).
     pub parts: u32,
+    /// What `auto` chose to run and why (`None` for the other models).
+    pub choice: Option<Choice>,
     /// Wall-clock seconds the physics of this frame took: its steps and the
     /// detection behind `max_overlap_rel`.
     pub physics_seconds: f64,
@@ -78,6 +81,7 @@ impl Snapshot {
             escaped: 0,
             counters: Counters::default(),
             parts: 1,
+            choice: None,
             physics_seconds: 0.0,
             steps: 0,
             settings,

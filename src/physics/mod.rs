@@ -1,5 +1,6 @@
 //! The physics: spheres in a cube, the collision models, the broad phase.
 //! It knows nothing of threads (it is handed an [`exec::Exec`]) or terminals.
+pub mod auto;
 pub mod broad;
 pub mod contact;
 mod detect;

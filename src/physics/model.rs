@@ -1,3 +1,4 @@
+use super::auto::{Choice, Tolerance};
 use super::exec::Exec;
 use super::world::World;
 use strum::{Display, EnumCount, EnumString, IntoStaticStr};
@@ -11,20 +12,29 @@ pub enum ModelKind {
     Discrete,
     Swept,
     Exact,
+    /// Runs the cheapest of the three predicted to keep the tolerance
+    /// (`src/physics/auto/`); the tolerance is part of the model asked.
+    Auto(Tolerance),
 }
 
 impl ModelKind {
     /// Every model, in the `m` key's cycle (a new variant does not compile
     /// until it is listed here).
-    pub const ALL: [ModelKind; Self::COUNT] =
-        [ModelKind::Discrete, ModelKind::Swept, ModelKind::Exact];
+    pub const ALL: [ModelKind; Self::COUNT] = [
+        ModelKind::Discrete,
+        ModelKind::Swept,
+        ModelKind::Exact,
+        ModelKind::Auto(Tolerance::EXACT),
+    ];
+    /// The models that `auto` chooses among (and `tradeoff` measures).
+    pub const FIXED: [ModelKind; 3] = [ModelKind::Discrete, ModelKind::Swept, ModelKind::Exact];
 
     pub fn name(self) -> &'static str {
         self.into()
     }
 
     /// Whether a step runs as one sequence on one lane, whatever the
-    /// executor offers: `exact` runs one event loop.
+    /// executor offers: `exact` runs one event loop (`auto` may run any).
     pub fn runs_on_one_lane(self) -> bool {
         matches!(self, ModelKind::Exact)
     }
@@ -32,8 +42,20 @@ impl ModelKind {
     /// The next model in the `m` key's cycle.
     #[must_use]
     pub fn next(self) -> ModelKind {
-        let i = Self::ALL.iter().position(|&m| m == self).unwrap_or(0);
-        Self::ALL[(i + 1) % Self::ALL.len()]
+        match self {
+            ModelKind::Discrete => ModelKind::Swept,
+            ModelKind::Swept => ModelKind::Exact,
+            ModelKind::Exact => ModelKind::Auto(Tolerance::EXACT),
+            ModelKind::Auto(_) => ModelKind::Discrete,
+        }
+    }
+
+    /// The tolerance asked, for `auto`.
+    pub fn tolerance(self) -> Option<Tolerance> {
+        match self {
+            ModelKind::Auto(t) => Some(t),
+            _ => None,
+        }
     }
 
     pub fn build(self) -> Box<dyn Model> {
@@ -41,6 +63,7 @@ impl ModelKind {
             ModelKind::Discrete => Box::new(super::discrete::Discrete::default()),
             ModelKind::Swept => Box::new(super::swept::Swept::default()),
             ModelKind::Exact => Box::new(super::exact::Exact::default()),
+            ModelKind::Auto(t) => Box::new(super::auto::Auto::new(t)),
         }
     }
 }
@@ -64,6 +87,10 @@ pub trait Model: Send {
     fn max_overlap_rel(&mut self, _world: &World, _dt: f64, _exec: &dyn Exec) -> Option<f64> {
         None
     }
+    /// What `auto` chose to run and why (`None` for the other models).
+    fn choice(&self) -> Option<&Choice> {
+        None
+    }
 }
 
 #[cfg(test)]
@@ -73,7 +100,7 @@ mod tests {
     #[test]
     fn names_parse_back_and_the_cycle_visits_every_model() {
         let names: Vec<_> = ModelKind::ALL.map(ModelKind::name).into();
-        assert_eq!(names, ["discrete", "swept", "exact"]);
+        assert_eq!(names, ["discrete", "swept", "exact", "auto"]);
         for m in ModelKind::ALL {
             assert_eq!(m.to_string(), m.name());
             assert_eq!(m.name().parse(), Ok(m));
@@ -87,7 +114,16 @@ mod tests {
         }
         assert_eq!(
             seen,
-            [ModelKind::Swept, ModelKind::Exact, ModelKind::Discrete]
+            [
+                ModelKind::Swept,
+                ModelKind::Exact,
+                ModelKind::Auto(Tolerance::EXACT),
+                ModelKind::Discrete
+            ]
         );
+        let loose = ModelKind::Auto(Tolerance::new(0.1).unwrap());
+        assert_eq!(loose.name(), "auto");
+        assert_eq!(loose.next(), ModelKind::Discrete);
+        assert_eq!(loose.tolerance().map(Tolerance::fraction), Some(0.1));
     }
 }

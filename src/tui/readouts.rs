@@ -4,6 +4,7 @@ use super::state::{AppState, representative_radius};
 use super::theme::Palette;
 use crate::engine::{Snapshot, Threading, physics_threads};
 use crate::physics::ModelKind;
+use crate::physics::auto::Choice;
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
 use ratatui::text::{Line, Span};
@@ -130,7 +131,10 @@ impl Readouts<'_> {
             row("tick", tick),
             row("count", format!("{}", snap.count)),
             row("radius", self.radius()),
-            row("model", model_row(s.model, snap.parts)),
+            row(
+                "model",
+                model_row(s.model, snap.parts, snap.choice.as_ref()),
+            ),
             row("style", s.style.name().to_string()),
             row("colour", self.colour()),
             row("fps", self.fps(false)),
@@ -186,10 +190,14 @@ impl Readouts<'_> {
                 Span::raw(bv),
             ])
         };
+        let name = match &snap.choice {
+            Some(c) => format!("{}→{}", s.model.name(), c.model),
+            None => s.model.name().to_string(),
+        };
         let model = if snap.parts > 1 {
-            format!("{} cut {}", s.model.name(), snap.parts)
+            format!("{name} cut {}", snap.parts)
         } else {
-            s.model.name().to_string()
+            name
         };
         vec![
             Line::from(vec![
@@ -260,11 +268,16 @@ impl Readouts<'_> {
 
 /// The model, and the parts it cut its last step into when it did (fast
 /// or crowded scenes: see `physics/swept/parts.rs`).
-fn model_row(model: ModelKind, parts: u32) -> String {
+/// `auto` says what it runs and why.
+fn model_row(model: ModelKind, parts: u32, choice: Option<&Choice>) -> String {
+    let name = match choice {
+        Some(c) => format!("{} → {} ({})", model.name(), c.model, c.reason),
+        None => model.name().to_string(),
+    };
     if parts > 1 {
-        format!("{:<8} steps cut in {parts}", model.name())
+        format!("{name:<8} steps cut in {parts}")
     } else {
-        model.name().to_string()
+        name
     }
 }
 

@@ -36,7 +36,7 @@ use super::world::World;
 use cluster::Coarse;
 use glam::DVec3;
 use parking_lot::Mutex;
-pub use parts::ADDED_PAIRS;
+pub use parts::{ADDED_PAIRS, parts};
 pub use rounds::RoundStats;
 use rounds::Rounds;
 

@@ -1,0 +1,261 @@
+//! `auto`'s choice: a pure function of a summary of the scene, `dt` and the
+//! tolerance, so every machine and every threading mode chooses alike. The
+//! costs are predicted from event and step counts, calibrated once against
+//! `ballpit tradeoff` (docs/models.md, "auto"), never timed.
+use super::Tolerance;
+use crate::physics::exact::{EVENT_CAP_BASE, EVENT_CAP_PER_SPHERE};
+use crate::physics::model::ModelKind;
+use crate::physics::world::World;
+use std::f64::consts::PI;
+
+/// Predicted cost of one `exact` event (contact, wall or cell crossing),
+/// of a sphere in a step, of a sphere's sync at the end of an `advance`,
+/// and of a sphere in the overlap readout the engine asks for each frame,
+/// in seconds: fitted to `ballpit bench` and `ballpit tradeoff` on the gas
+/// preset (docs/models.md, "auto").
+const EXACT_EVENT: f64 = 4.4e-7;
+const EXACT_SPHERE_STEP: f64 = 1.8e-9;
+const EXACT_SPHERE_SYNC: f64 = 1.1e-8;
+const EXACT_SPHERE_READOUT: f64 = 4.3e-8;
+/// `swept`: one sphere in one part of a step, and one contact or wall hit
+/// (its overlap readout is the next step's detection, reused).
+const SWEPT_SPHERE_STEP: f64 = 3.5e-8;
+const SWEPT_EVENT: f64 = 1.5e-6;
+/// `discrete`: one sphere in one step (move, grid, overlaps).
+const DISCRETE_SPHERE_STEP: f64 = 3.4e-8;
+/// `swept` is taken over `exact` only when predicted this much cheaper:
+/// near the boundary the model exact to rounding keeps the promise.
+const SWEPT_MARGIN: f64 = 1.2;
+/// `discrete` sinks a pair by up to its closing speed × dt; it is let in
+/// only when twice that bound (speeds spread by collisions) stays within
+/// the tolerance.
+const DISCRETE_MARGIN: f64 = 2.0;
+/// `swept`'s event cap per step (`swept/` docs: 10 000 + 64 a sphere).
+const SWEPT_CAP_BASE: f64 = 10_000.0;
+const SWEPT_CAP_PER_SPHERE: f64 = 64.0;
+
+/// What the choice reads from the scene: one pass over the spheres.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Summary {
+    pub count: usize,
+    pub size: f64,
+    pub r_min: f64,
+    pub r_max: f64,
+    pub r_mean: f64,
+    pub packing: f64,
+    pub v_rms: f64,
+    pub v_max: f64,
+}
+
+impl Summary {
+    pub fn of(world: &World) -> Summary {
+        let n = world.spheres.len();
+        let (mut r_min, mut r_max, mut r_sum, mut vol, mut vv, mut v_max) =
+            (f64::INFINITY, 0.0_f64, 0.0, 0.0, 0.0, 0.0_f64);
+        for s in &world.spheres {
+            r_min = r_min.min(s.radius);
+            r_max = r_max.max(s.radius);
+            r_sum += s.radius;
+            vol += s.radius.powi(3);
+            let v2 = s.vel.length_squared();
+            vv += v2;
+            v_max = v_max.max(v2);
+        }
+        let nf = n.max(1) as f64;
+        Summary {
+            count: n,
+            size: world.size,
+            r_min: if n == 0 { 0.0 } else { r_min },
+            r_max,
+            r_mean: r_sum / nf,
+            packing: 4.0 / 3.0 * PI * vol / world.size.powi(3),
+            v_rms: (vv / nf).sqrt(),
+            v_max: v_max.sqrt(),
+        }
+    }
+}
+
+/// The model chosen and why, in the screen's words.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Choice {
+    pub model: ModelKind,
+    pub reason: String,
+    /// The tolerance cannot be kept by any model within its budget.
+    pub unmet: bool,
+}
+
+/// Predicted events per simulated second: contacts (Enskog's rate with
+/// the Carnahan–Starling contact value), wall hits and `exact`'s cell
+/// crossings (cells a little over a diameter, at most 4 a sphere).
+#[derive(Clone, Copy, Debug)]
+pub struct Rates {
+    pub contacts: f64,
+    pub walls: f64,
+    pub crossings: f64,
+}
+
+pub fn rates(s: &Summary) -> Rates {
+    let n = s.count as f64;
+    if s.count < 2 || s.size <= 0.0 {
+        return Rates {
+            contacts: 0.0,
+            walls: 0.0,
+            crossings: 0.0,
+        };
+    }
+    let phi = s.packing.min(0.6);
+    let g = (1.0 - 0.5 * phi) / (1.0 - phi).powi(3);
+    let density = n / s.size.powi(3);
+    let sigma = 2.0 * s.r_mean;
+    // Enskog: z = 4 n σ² √(π kT/m) g, with kT/m = v_rms² / 3.
+    let per_sphere = 4.0 * density * sigma * sigma * (PI / 3.0).sqrt() * s.v_rms * g;
+    // Mean |v_x| of a Maxwell gas: v_rms √(2 / 3π); three axes.
+    let axis = 3.0 * s.v_rms * (2.0 / (3.0 * PI)).sqrt();
+    let per_side = (s.size / (2.0 * s.r_max.max(1e-300)))
+        .floor()
+        .clamp(1.0, (4.0 * n).cbrt().ceil().min(512.0));
+    // Dense scenes run on neighbour lists: no cell crossings.
+    let crossings = if s.packing > 0.3 {
+        0.0
+    } else {
+        n * axis * per_side / s.size
+    };
+    Rates {
+        contacts: 0.5 * n * per_sphere,
+        walls: n * axis / s.size,
+        crossings,
+    }
+}
+
+/// Predicted seconds of physics per simulated second, per model.
+#[derive(Clone, Copy, Debug)]
+pub struct Costs {
+    pub discrete: f64,
+    pub swept: f64,
+    pub exact: f64,
+}
+
+/// `frame`: steps per `advance` (the tick), each call ending in a sync,
+/// and in an overlap readout if `readouts`.
+pub fn costs(s: &Summary, dt: f64, swept_parts: u32, frame: u64, readouts: bool) -> Costs {
+    let r = rates(s);
+    let steps = s.count as f64 / dt;
+    let frames = steps / frame.max(1) as f64;
+    let per_frame = EXACT_SPHERE_SYNC + if readouts { EXACT_SPHERE_READOUT } else { 0.0 };
+    Costs {
+        discrete: DISCRETE_SPHERE_STEP * steps,
+        swept: SWEPT_SPHERE_STEP * steps * f64::from(swept_parts.max(1))
+            + SWEPT_EVENT * (r.contacts + r.walls),
+        exact: EXACT_EVENT * (r.contacts + r.walls + r.crossings)
+            + EXACT_SPHERE_STEP * steps
+            + per_frame * frames,
+    }
+}
+
+/// The deepest overlap `discrete` may leave, as a fraction of the smaller
+/// radius: two spheres closing at up to twice the top speed for one step.
+pub fn discrete_overlap(s: &Summary, dt: f64) -> f64 {
+    if s.r_min > 0.0 {
+        2.0 * s.v_max * dt / s.r_min
+    } else {
+        f64::INFINITY
+    }
+}
+
+fn ratio(a: f64, b: f64) -> String {
+    let x = a / b.max(1e-300);
+    if x >= 10.0 {
+        format!("{x:.0}×")
+    } else {
+        format!("{x:.1}×")
+    }
+}
+
+/// How `choose` is asked: `dt`, steps per frame, the tolerance, `swept`'s
+/// parts for this scene, and the strictness floor (1: no `discrete`, 2:
+/// `exact` only, once the cheaper ones broke the tolerance).
+#[derive(Clone, Copy, Debug)]
+pub struct Ask {
+    pub dt: f64,
+    pub frame: u64,
+    pub tol: Tolerance,
+    pub parts: u32,
+    pub floor: u8,
+    /// The caller reads the deepest overlap after every `advance` (the
+    /// engine does; `tradeoff` does not).
+    pub readouts: bool,
+}
+
+/// The cheapest model predicted to keep the tolerance.
+pub fn choose(s: &Summary, ask: Ask) -> Choice {
+    let Ask {
+        dt,
+        frame,
+        tol,
+        parts: swept_parts,
+        floor,
+        readouts,
+    } = ask;
+    let t = tol.fraction();
+    let c = costs(s, dt, swept_parts, frame, readouts);
+    let r = rates(s);
+    let per_step = (r.contacts + r.walls + r.crossings) * dt;
+    let exact_cap = (EVENT_CAP_BASE + EVENT_CAP_PER_SPHERE * s.count as u64) as f64;
+    let swept_cap = SWEPT_CAP_BASE + SWEPT_CAP_PER_SPHERE * s.count as f64;
+    let tol_text = format!("tol {tol}");
+    if per_step > exact_cap {
+        return Choice {
+            model: ModelKind::Exact,
+            reason: format!(
+                "tolerance cannot be met: ~{per_step:.0} events a step > exact's cap {exact_cap:.0}; {tol_text}"
+            ),
+            unmet: true,
+        };
+    }
+    let depth = discrete_overlap(s, dt);
+    if floor == 0 && t > 0.0 && DISCRETE_MARGIN * depth <= t && c.discrete < c.swept.min(c.exact) {
+        return Choice {
+            model: ModelKind::Discrete,
+            reason: format!(
+                "sinks ≤{depth:.2} r < tol, {} cheaper than {}; {tol_text}",
+                ratio(c.swept.min(c.exact), c.discrete),
+                if c.exact <= c.swept { "exact" } else { "swept" }
+            ),
+            unmet: false,
+        };
+    }
+    let swept_fits = r.contacts.max(0.0) * dt / f64::from(swept_parts.max(1)) < swept_cap;
+    if floor <= 1 && swept_fits && c.swept * SWEPT_MARGIN < c.exact {
+        let frames = (EXACT_SPHERE_SYNC + EXACT_SPHERE_READOUT) * s.count as f64
+            / (dt * frame.max(1) as f64);
+        let why = if frames > 0.5 * c.exact {
+            format!("{frame} step a frame")
+        } else if r.crossings > r.contacts + r.walls {
+            "fast".to_string()
+        } else {
+            "coarse dt".to_string()
+        };
+        return Choice {
+            model: ModelKind::Swept,
+            reason: format!(
+                "{why}: {} cheaper than exact; {tol_text}",
+                ratio(c.exact, c.swept)
+            ),
+            unmet: false,
+        };
+    }
+    let why = if floor >= 2 && c.swept * SWEPT_MARGIN < c.exact {
+        "the cheaper models broke the tolerance".to_string()
+    } else if s.packing > 0.3 {
+        format!("dense: {} cheaper than swept", ratio(c.swept, c.exact))
+    } else if c.exact <= c.swept {
+        format!("{} cheaper than swept", ratio(c.swept, c.exact))
+    } else {
+        "near the boundary: the stricter model".to_string()
+    };
+    Choice {
+        model: ModelKind::Exact,
+        reason: format!("{why}; {tol_text}"),
+        unmet: false,
+    }
+}

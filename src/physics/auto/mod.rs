@@ -1,0 +1,204 @@
+//! `auto`: runs the cheapest of `discrete`, `swept` and `exact` predicted to
+//! keep the tolerance asked, for the scene as it is now (docs/models.md).
+//! It chooses again at the next `advance` after the spheres were edited,
+//! `dt` changed, or the model it runs broke the tolerance (then only
+//! stricter models are let in until the scene changes).
+mod choose;
+
+pub use choose::{Ask, Choice, Costs, Rates, Summary, choose, costs, discrete_overlap, rates};
+
+use super::exec::Exec;
+use super::model::{Model, ModelKind};
+use super::world::World;
+use std::fmt;
+
+/// The fraction of the smaller radius by which spheres may sink into each
+/// other, held in millionths so that a model kind stays `Eq` and `Hash`
+/// (a request finer than 1e-6 rounds to the stricter 0).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Tolerance(u32);
+
+impl Tolerance {
+    pub const EXACT: Tolerance = Tolerance(0);
+    const PER_UNIT: f64 = 1e6;
+    /// The `<` / `>` keys' steps.
+    pub const LADDER: [Tolerance; 6] = [
+        Tolerance(0),
+        Tolerance(1_000),
+        Tolerance(10_000),
+        Tolerance(100_000),
+        Tolerance(500_000),
+        Tolerance(1_000_000),
+    ];
+
+    /// `t` in [0, 1]; anything else (negative, NaN, above 1) is refused.
+    pub fn new(t: f64) -> Option<Tolerance> {
+        (0.0..=1.0)
+            .contains(&t)
+            // In [0, 1e6] after the check, so the cast is exact.
+            .then(|| Tolerance((t * Self::PER_UNIT).floor() as u32))
+    }
+
+    pub fn fraction(self) -> f64 {
+        f64::from(self.0) / Self::PER_UNIT
+    }
+
+    /// The next step of the ladder up (looser) or down (tighter).
+    #[must_use]
+    pub fn step(self, looser: bool) -> Tolerance {
+        let l = &Self::LADDER;
+        if looser {
+            l.iter()
+                .copied()
+                .find(|&x| x > self)
+                .unwrap_or(l[l.len() - 1])
+        } else {
+            l.iter().rev().copied().find(|&x| x < self).unwrap_or(l[0])
+        }
+    }
+}
+
+impl fmt::Display for Tolerance {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.fraction())
+    }
+}
+
+/// How strict the models let in are: 0 all, 1 `swept` and `exact`, 2 `exact`.
+fn level(m: ModelKind) -> u8 {
+    match m {
+        ModelKind::Discrete => 0,
+        ModelKind::Swept => 1,
+        ModelKind::Exact | ModelKind::Auto(_) => 2,
+    }
+}
+
+/// What the choice was made for: the spheres' edit generation, their
+/// count, `dt`, the steps per frame and whether overlaps are read.
+type Key = (u64, usize, u64, u64, bool);
+
+pub struct Auto {
+    tol: Tolerance,
+    inner: Box<dyn Model>,
+    choice: Option<Choice>,
+    key: Option<Key>,
+    /// Models below this level broke the tolerance on this scene.
+    floor: u8,
+    /// Why the floor was raised, for the reason.
+    broke: Option<String>,
+    /// The choice is to be made again at the next `advance`.
+    again: bool,
+    /// Whether the caller reads the overlap after each `advance`: assumed
+    /// (the engine does) until an `advance` follows one without a readout.
+    readouts: bool,
+    read_since: bool,
+}
+
+impl Auto {
+    pub fn new(tol: Tolerance) -> Auto {
+        Auto {
+            tol,
+            inner: ModelKind::Exact.build(),
+            choice: None,
+            key: None,
+            floor: 0,
+            broke: None,
+            again: true,
+            readouts: true,
+            read_since: true,
+        }
+    }
+
+    fn rechoose(&mut self, world: &World, dt: f64, frame: u64) {
+        let summary = Summary::of(world);
+        let ask = Ask {
+            dt,
+            frame,
+            tol: self.tol,
+            parts: super::swept::parts(&world.spheres, world.size, dt),
+            floor: self.floor,
+            readouts: self.readouts,
+        };
+        let mut c = choose(&summary, ask);
+        if let Some(b) = &self.broke {
+            c.reason = format!("{b}: stricter; {}", c.reason);
+        }
+        if c.model != self.inner.kind() {
+            self.inner = c.model.build();
+        }
+        self.choice = Some(c);
+        self.again = false;
+    }
+
+    /// The model running broke the tolerance: move up.
+    fn broke(&mut self, what: &str) {
+        let m = self.inner.kind();
+        if level(m) >= 2 || self.choice.as_ref().is_some_and(|c| c.unmet) {
+            return;
+        }
+        self.floor = level(m) + 1;
+        self.broke = Some(format!("{m} broke tol ({what})"));
+        self.again = true;
+    }
+}
+
+impl Model for Auto {
+    fn kind(&self) -> ModelKind {
+        ModelKind::Auto(self.tol)
+    }
+
+    fn advance(&mut self, world: &mut World, dt: f64, steps: u64, exec: &dyn Exec) {
+        self.readouts = self.read_since;
+        self.read_since = false;
+        let key = (
+            world.generation(),
+            world.spheres.len(),
+            dt.to_bits(),
+            steps,
+            self.readouts,
+        );
+        if self.key != Some(key) {
+            self.key = Some(key);
+            self.floor = 0;
+            self.broke = None;
+            self.again = true;
+        }
+        if self.again {
+            self.rechoose(world, dt, steps);
+        }
+        let capped = world.counters.capped_steps;
+        self.inner.advance(world, dt, steps, exec);
+        if world.counters.capped_steps > capped {
+            self.broke("steps cut short");
+        }
+    }
+
+    fn invalidate(&mut self) {
+        self.inner.invalidate();
+        self.key = None;
+    }
+
+    fn last_parts(&self) -> u32 {
+        self.inner.last_parts()
+    }
+
+    /// `discrete` leaves the readout to the caller; `auto` needs it to
+    /// check its promise, so it measures it then (a grid pass, as the
+    /// engine's own would be).
+    fn max_overlap_rel(&mut self, world: &World, dt: f64, exec: &dyn Exec) -> Option<f64> {
+        self.read_since = true;
+        let depth = if self.inner.kind() == ModelKind::Discrete {
+            Some(world.max_overlap_rel())
+        } else {
+            self.inner.max_overlap_rel(world, dt, exec)
+        };
+        if depth.is_some_and(|d| d > self.tol.fraction() + 1e-9) {
+            self.broke("overlap");
+        }
+        depth
+    }
+
+    fn choice(&self) -> Option<&Choice> {
+        self.choice.as_ref()
+    }
+}

@@ -1,0 +1,379 @@
+//! `auto`: its choice on the presets (a table), the promise kept on random
+//! scenes, the same bits in every threading mode, and a live edit that
+//! crosses a boundary.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+use ballpit::engine::{Command, Engine, Settings, Threading};
+use ballpit::physics::auto::{Ask, Summary, Tolerance, choose};
+use ballpit::physics::swept::parts;
+use ballpit::physics::{ModelKind, Serial, Sphere, World};
+use ballpit::scene::{SceneSpec, build_world};
+use glam::DVec3;
+use rand::{Rng, SeedableRng};
+use rand_xoshiro::Xoshiro256PlusPlus;
+
+const PRESETS: [&str; 6] = [
+    "gas",
+    "billiards",
+    "dense",
+    "projectiles",
+    "cradle",
+    "mixed",
+];
+const DTS: [f64; 3] = [1.0 / 15.0, 1.0 / 60.0, 1.0 / 1920.0];
+
+fn preset(name: &str) -> World {
+    build_world(&SceneSpec {
+        scene: Some(name.into()),
+        seed: Some(1),
+        ..Default::default()
+    })
+    .unwrap()
+}
+
+fn tol(t: f64) -> Tolerance {
+    Tolerance::new(t).unwrap()
+}
+
+fn ask(w: &World, dt: f64, tol: Tolerance) -> Ask {
+    Ask {
+        dt,
+        frame: 1,
+        tol,
+        parts: parts(&w.spheres, w.size, dt),
+        floor: 0,
+        readouts: true,
+    }
+}
+
+fn chosen(w: &World, dt: f64, t: Tolerance) -> ModelKind {
+    let c = choose(&Summary::of(w), ask(w, dt, t));
+    eprintln!("{dt:.2e} {t}: {} ({})", c.model, c.reason);
+    c.model
+}
+
+/// The calibration's verdict on the presets at one step a frame (the
+/// screen's default tick; docs/models.md, "auto"): `exact` on the dense
+/// preset, `swept` where exact's per-frame sync and readout or its cell
+/// crossings cost more; `discrete` never keeps 0.1 of a radius on a preset
+/// at these steps.
+#[test]
+fn the_presets_choose_as_the_table_says() {
+    use ModelKind::{Exact as E, Swept as S};
+    let table: [(&str, [ModelKind; 3]); 6] = [
+        ("gas", [S, S, S]),
+        ("billiards", [E, S, S]),
+        ("dense", [E, E, E]),
+        ("projectiles", [S, S, S]),
+        ("cradle", [S, S, S]),
+        ("mixed", [E, S, S]),
+    ];
+    for t in [0.0, 0.01, 0.1] {
+        let got: Vec<_> = table
+            .iter()
+            .map(|(name, _)| (*name, DTS.map(|dt| chosen(&preset(name), dt, tol(t)))))
+            .collect();
+        let mut want = table.to_vec();
+        if t >= 0.1 {
+            // At the fine step the slow presets sink at most a few
+            // hundredths of a radius: `discrete` keeps 0.1 (dense measured
+            // 0.017 over 2 s, docs/models.md).
+            for row in [1, 2, 4] {
+                want[row].1[2] = ModelKind::Discrete;
+            }
+        }
+        assert_eq!(got, want, "tolerance {t}");
+    }
+}
+
+/// A scene the choice cannot keep within exact's event cap: the strictest
+/// model, and the reason says why.
+#[test]
+fn an_impossible_scene_takes_exact_and_says_so() {
+    let mut w = preset("gas");
+    for s in &mut w.spheres {
+        s.vel *= 2e4;
+    }
+    let c = choose(&Summary::of(&w), ask(&w, 1.0 / 15.0, tol(0.0)));
+    assert_eq!(c.model, ModelKind::Exact);
+    assert!(c.unmet);
+    assert!(c.reason.contains("cannot be met"), "{}", c.reason);
+}
+
+/// Spheres on a jittered cubic lattice, radii log-uniform over `spread`
+/// scaled to `packing` (less where the lattice cannot hold it), speeds
+/// `speed` × [0.5, 1.5) in random directions.
+fn random_scene(
+    rng: &mut Xoshiro256PlusPlus,
+    n: usize,
+    packing: f64,
+    spread: f64,
+    speed: f64,
+) -> World {
+    let side = (n as f64).cbrt().ceil() as usize;
+    let cell = 1.0 / side as f64;
+    let unit: Vec<f64> = (0..n)
+        .map(|_| spread.powf(rng.random_range(0.0..1.0)))
+        .collect();
+    let cubes: f64 = unit.iter().map(|u| u.powi(3)).sum();
+    let want = (packing / (4.0 / 3.0 * std::f64::consts::PI * cubes)).cbrt();
+    let top = unit.iter().copied().fold(0.0, f64::max);
+    let base = want.min(0.45 * cell / top);
+    let spheres = unit
+        .iter()
+        .enumerate()
+        .map(|(i, u)| {
+            let r = base * u;
+            let (x, y, z) = (i % side, (i / side) % side, i / (side * side));
+            let centre = DVec3::new(x as f64 + 0.5, y as f64 + 0.5, z as f64 + 0.5) * cell;
+            let room = 0.5 * cell - r;
+            let jitter = DVec3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            ) * room
+                * 0.9;
+            let dir = DVec3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            )
+            .normalize_or(DVec3::X);
+            let v = dir * speed * rng.random_range(0.5..1.5);
+            Sphere::new(centre + jitter, v, r)
+        })
+        .collect();
+    World::new(1.0, spheres)
+}
+
+/// 60 scenes over count, packing, speed, radius spread, `dt` and the
+/// tolerance: whatever `auto` runs keeps the tolerance (deepest overlap
+/// within `T` of the smaller radius), keeps energy and loses no sphere.
+/// Few steps each, so the test stays cheap; larger counts go slower.
+#[test]
+fn random_scenes_keep_the_tolerance() {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(29);
+    let mut seen = std::collections::BTreeMap::new();
+    for case in 0..60 {
+        let n = if case % 12 == 11 {
+            rng.random_range(5_000..=20_000)
+        } else {
+            (100.0 * 30f64.powf(rng.random_range(0.0..1.0))) as usize
+        };
+        let packing = 0.001 * 450f64.powf(rng.random_range(0.0..1.0));
+        let mut speed = 0.01 * 2000f64.powf(rng.random_range(0.0..1.0));
+        if n > 3_000 {
+            speed = speed.min(1.0);
+        }
+        let spread = 100f64.powf(rng.random_range(0.0..1.0));
+        let dt = DTS[rng.random_range(0..DTS.len())];
+        let t = [0.0, 0.01, 0.1, 0.5][rng.random_range(0..4)];
+        let world = random_scene(&mut rng, n, packing, spread, speed);
+        let what = format!(
+            "case {case}: n {n}, packing {packing:.3}, speed {speed:.2}, spread {spread:.1}, dt {dt:.2e}, tol {t}"
+        );
+        assert_eq!(world.max_overlap_rel(), 0.0, "{what}: the start overlaps");
+        let mut model = ModelKind::Auto(tol(t)).build();
+        let mut w = world.clone();
+        let e0 = w.kinetic_energy();
+        let mut worst: f64 = 0.0;
+        for _ in 0..3 {
+            model.advance(&mut w, dt, 1, &Serial);
+            worst = worst.max(w.max_overlap_rel());
+            let _ = model.max_overlap_rel(&w, dt, &Serial);
+        }
+        let c = model.choice().unwrap().clone();
+        *seen.entry(c.model.name()).or_insert(0) += 1;
+        let de = (w.kinetic_energy() - e0).abs() / e0;
+        assert!(de < 1e-9, "{what}: energy {de:e}");
+        assert_eq!(w.escaped(), 0, "{what}");
+        if !c.unmet {
+            assert_eq!(w.counters.capped_steps, 0, "{what}: {}", c.reason);
+            assert!(
+                worst <= t + 1e-9,
+                "{what}: {} sank {worst:e} r ({})",
+                c.model,
+                c.reason
+            );
+        }
+    }
+    eprintln!("choices: {seen:?}");
+}
+
+fn settings(model: ModelKind, threading: Threading, dt: f64) -> Settings {
+    Settings {
+        model,
+        dt,
+        tick: 3,
+        threading,
+        threads: 2,
+    }
+}
+
+/// `auto` gives the same bits and the same choice in every threading mode
+/// on every preset.
+#[test]
+fn auto_is_bit_identical_across_threading_modes_on_every_preset() {
+    for name in PRESETS {
+        let start = preset(name);
+        let mut first: Option<(World, ModelKind)> = None;
+        for mode in Threading::ALL {
+            let mut e = Engine::new(
+                start.clone(),
+                settings(ModelKind::Auto(tol(0.0)), mode, 1.0 / 60.0),
+            )
+            .unwrap();
+            for _ in 0..4 {
+                e.start_frame().unwrap();
+                e.finish_frame().unwrap();
+            }
+            let chosen = e.snapshot().choice.as_ref().unwrap().model;
+            let w = e.world().clone();
+            assert_eq!(w.escaped(), 0, "{name} {mode}");
+            match &first {
+                None => first = Some((w, chosen)),
+                Some((w0, c0)) => {
+                    assert_eq!(&w, w0, "{name}: {mode} differs");
+                    assert_eq!(chosen, *c0, "{name}: {mode} chose otherwise");
+                }
+            }
+        }
+    }
+}
+
+/// A live edit that crosses a boundary changes the choice at the next
+/// frame: slowing the projectiles' cousins by growing them into a crowd.
+#[test]
+fn a_live_edit_across_a_boundary_changes_the_choice_at_the_next_frame() {
+    let start = preset("projectiles");
+    let mut e = Engine::headless(
+        start,
+        settings(ModelKind::Auto(tol(0.0)), Threading::Off, 1.0 / 60.0),
+    )
+    .unwrap();
+    e.start_frame().unwrap();
+    e.finish_frame().unwrap();
+    assert_eq!(
+        e.snapshot().choice.as_ref().unwrap().model,
+        ModelKind::Swept
+    );
+    e.command(Command::SetRadius(0.05));
+    e.start_frame().unwrap();
+    let snap = e.finish_frame().unwrap();
+    let c = snap.choice.as_ref().unwrap();
+    assert_eq!(c.model, ModelKind::Exact, "{}", c.reason);
+    assert!(snap.max_overlap_rel <= 1e-9);
+}
+
+fn ballpit(args: &[&str]) -> std::process::Output {
+    assert_cmd::Command::cargo_bin("ballpit")
+        .unwrap()
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// `--tolerance` out of [0, 1] is refused with one line and exit 2; with
+/// a model other than `auto` it warns; the JSON says what `auto` chose.
+#[test]
+fn the_tolerance_flag_is_checked_and_reported() {
+    for bad in ["-0.5", "NaN", "1.5"] {
+        let out = ballpit(&[
+            "bench",
+            "--model",
+            "auto",
+            "--tolerance",
+            bad,
+            "--steps",
+            "2",
+        ]);
+        assert_eq!(out.status.code(), Some(2), "{bad}");
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.contains("--tolerance must be"), "{err}");
+    }
+    let out = ballpit(&[
+        "bench",
+        "--model",
+        "exact",
+        "--tolerance",
+        "0.1",
+        "--steps",
+        "2",
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(
+        String::from_utf8(out.stderr)
+            .unwrap()
+            .contains("only steers --model auto")
+    );
+    let json = |args: &[&str]| -> serde_json::Value {
+        let out = ballpit(args);
+        assert_eq!(out.status.code(), Some(0));
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let v = json(&[
+        "bench", "--scene", "dense", "--model", "auto", "--steps", "4",
+    ]);
+    assert_eq!(v["model"], "auto");
+    assert_eq!(v["model_chosen"], "exact");
+    assert!(
+        v["model_reason"].as_str().unwrap().starts_with("dense"),
+        "{v}"
+    );
+    let v = json(&[
+        "bench", "--model", "auto", "--speed", "10000", "--dt", "1/15", "--steps", "2",
+    ]);
+    assert_eq!(v["model_chosen"], "exact");
+    let warned = v["warnings"].to_string();
+    assert!(warned.contains("could not meet its tolerance"), "{warned}");
+    let v = json(&["bench", "--model", "swept", "--steps", "2"]);
+    assert!(v["model_chosen"].is_null());
+}
+
+/// The readouts' model row names what `auto` runs (its reason follows as
+/// far as the panel is wide).
+#[test]
+fn the_model_row_says_what_auto_runs() {
+    use ballpit::tui::readouts::{Readouts, Stats};
+    use ballpit::tui::state::AppState;
+    use ballpit::tui::theme::Palette;
+    let s = settings(ModelKind::Auto(tol(0.0)), Threading::Off, 1.0 / 60.0);
+    let mut e = Engine::new(preset("dense"), s).unwrap();
+    e.start_frame().unwrap();
+    let snap = e.finish_frame().unwrap().clone();
+    let st = AppState::new(&s, snap.count, 0.0363, 30.0);
+    let stats = Stats {
+        fps: 30.0,
+        physics_seconds: snap.physics_seconds,
+        render_seconds: 0.001,
+        frame_bytes: 1000,
+        steps_per_second: 30.0,
+        collisions_per_second: 1.0,
+        detected: Some(Palette::True),
+        link: None,
+        link_slow: false,
+    };
+    let mut t = ratatui::Terminal::new(ratatui::backend::TestBackend::new(
+        72,
+        ballpit::tui::readouts::HEIGHT,
+    ))
+    .unwrap();
+    t.draw(|f| {
+        f.render_widget(
+            Readouts {
+                state: &st,
+                snap: &snap,
+                stats: &stats,
+                palette: Palette::C16,
+            },
+            f.area(),
+        );
+    })
+    .unwrap();
+    let buf = t.backend().buffer();
+    let text: Vec<String> = (0..buf.area.height)
+        .map(|y| (0..buf.area.width).map(|x| buf[(x, y)].symbol()).collect())
+        .collect();
+    let row = text.iter().find(|r| r.contains("model")).unwrap();
+    assert!(row.contains("auto → exact (dense:"), "{text:#?}");
+}
