@@ -233,6 +233,7 @@ fn threads_panel() {
             Threads {
                 report: &r,
                 palette: Palette::C16,
+                pool: None,
             },
             f.area(),
         );

@@ -123,6 +123,10 @@ pub fn draw(frame: &mut Frame, raster: &mut Raster, v: &View) {
         Threads {
             report: v.report,
             palette: v.palette,
+            pool: v
+                .snap
+                .pool_busy
+                .map(|b| threads::pool_line(&b, v.snap.count)),
         },
         a.threads,
     );

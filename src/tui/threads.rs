@@ -20,6 +20,21 @@ const BLOCK: usize = 8;
 pub struct Threads<'a> {
     pub report: &'a CpuReport,
     pub palette: Palette,
+    /// `pool_line` of the last frame, when a pool ran it.
+    pub pool: Option<String>,
+}
+
+/// How many pool threads the scene keeps busy, and why no more, e.g.
+/// `pool: 1 of 64 busy — 1000 spheres too few` (short, to fit the panel).
+pub fn pool_line(b: &crate::physics::exec::Busy, spheres: usize) -> String {
+    use crate::physics::exec::Bound;
+    let why = match b.bound {
+        Bound::Work => format!("{spheres} spheres too few"),
+        Bound::Blocks => "too few blocks".into(),
+        Bound::Cores => "one a core".into(),
+        Bound::Threads => "all".into(),
+    };
+    format!("pool: {} of {} busy — {why}", b.busy, b.threads)
 }
 
 /// `values` (percent of one core) as bars, newest last, at most `width`.
@@ -89,6 +104,10 @@ pub fn full_height(report: &CpuReport) -> u16 {
     report.threads.len().max(1) as u16 + 5
 }
 
+fn has_pool(report: &CpuReport) -> bool {
+    report.threads.iter().any(|t| t.name.starts_with("pool-"))
+}
+
 /// Panel rows (border included) for the compact view with a cell per
 /// thread, at `inner_width` columns.
 pub fn compact_height(report: &CpuReport, inner_width: usize) -> u16 {
@@ -96,7 +115,7 @@ pub fn compact_height(report: &CpuReport, inner_width: usize) -> u16 {
     let group_rows = group.map_or(0, |(_, m)| {
         let loads = vec![0.0; m.len()];
         1 + grid(&loads, inner_width, usize::MAX).1.len()
-    });
+    }) + usize::from(has_pool(report));
     // The totals take one row, two on narrow panels: count two.
     // An empty report still takes a row to say so.
     (singles.len().div_ceil(2).max(1) + group_rows + 2 + 2) as u16
@@ -218,6 +237,11 @@ impl Threads<'_> {
                 }
                 lines.push(Line::from(spans));
             }
+            lines.extend(
+                self.pool
+                    .clone()
+                    .map(|p| Line::from(Span::styled(p, label))),
+            );
         }
         lines.extend(
             totals
@@ -287,7 +311,13 @@ impl Widget for Threads<'_> {
         block.render(area, buf);
         let (w, h) = (usize::from(inner.width), usize::from(inner.height));
         let lines = if area.height >= full_height(self.report) {
-            self.lines(w)
+            let mut lines = self.lines(w);
+            // The pool's line above the totals, where a row is spare.
+            if let Some(p) = self.pool.clone().filter(|_| h > lines.len()) {
+                let at = lines.len().saturating_sub(2);
+                lines.insert(at, Line::from(Span::styled(p, self.palette.label())));
+            }
+            lines
         } else {
             self.compact_lines(w, h)
         };
@@ -298,6 +328,24 @@ impl Widget for Threads<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_pool_line_says_how_many_are_busy_and_why() {
+        use crate::physics::exec::{Bound, Busy};
+        let b = |busy, bound| Busy {
+            busy,
+            threads: 64,
+            bound,
+        };
+        assert_eq!(
+            super::pool_line(&b(1, Bound::Work), 1000),
+            "pool: 1 of 64 busy — 1000 spheres too few"
+        );
+        assert_eq!(
+            super::pool_line(&b(2, Bound::Cores), 100_000),
+            "pool: 2 of 64 busy — one a core"
+        );
+    }
 
     #[test]
     fn the_grid_doubles_threads_per_cell_until_it_fits() {
