@@ -25,10 +25,13 @@ pub struct PoolExec {
 impl PoolExec {
     pub fn new(threads: usize) -> anyhow::Result<PoolExec> {
         let threads = threads.max(1);
+        // The build error's text is its cause's, and its source that cause
+        // again: say it once, as bad input (exit 2), naming what failed.
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .thread_name(|i| format!("pool-{i}"))
-            .build()?;
+            .build()
+            .map_err(|e| refused(&format!("{threads} pool threads"), &e))?;
         let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
         Ok(PoolExec {
             pool,
@@ -53,6 +56,14 @@ impl PoolExec {
     pub fn thread_ids(&self) -> Vec<(String, i32)> {
         thread_ids(&self.pool)
     }
+}
+
+/// The system would not start a thread (`ulimit -u`, `ulimit -v`).
+fn refused(what: &str, e: &rayon::ThreadPoolBuildError) -> anyhow::Error {
+    crate::error::BadInput(format!(
+        "cannot start {what}: the system refused a thread ({e}); try fewer --threads or raise ulimit -u / ulimit -v"
+    ))
+    .into()
 }
 
 fn thread_ids(pool: &rayon::ThreadPool) -> Vec<(String, i32)> {
@@ -145,7 +156,8 @@ impl SplitExec {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(2)
             .thread_name(|i| SPLIT_NAMES[i].to_string())
-            .build()?;
+            .build()
+            .map_err(|e| refused("the two split threads", &e))?;
         Ok(SplitExec { pool })
     }
 
