@@ -69,6 +69,7 @@ fn order_percent_base_and_pool_total_at_three_sizes_and_four_pools() {
                 report: &r,
                 palette: Palette::Mono,
                 by_cpu: false,
+                pool: None,
             };
             let (iw, ih) = (usize::from(area.width) - 2, usize::from(area.height) - 2);
             let layout = panel.layout(iw, ih);
@@ -78,6 +79,7 @@ fn order_percent_base_and_pool_total_at_three_sizes_and_four_pools() {
                         report: &r,
                         palette: Palette::Mono,
                         by_cpu: false,
+                        pool: None,
                     },
                     f.area(),
                 );
@@ -176,6 +178,7 @@ fn s_sorts_the_rows_by_cpu_and_back() {
                     report: &r,
                     palette: Palette::Mono,
                     by_cpu,
+                    pool: None,
                 },
                 f.area(),
             );

@@ -234,6 +234,7 @@ fn threads_panel() {
                 report: &r,
                 palette: Palette::C16,
                 by_cpu: false,
+                pool: None,
             },
             f.area(),
         );

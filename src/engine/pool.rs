@@ -1,22 +1,51 @@
 //! The `pool` and `split` executors: rayon pools of named threads. Rayon's
 //! idle threads spin for a few dozen yields and then sleep on a condition
-//! variable, so a pool that is not in use costs no CPU.
+//! variable, so a pool that is not in use costs no CPU. A section of `k`
+//! lanes hands out `k - 1` jobs and runs one itself, so it wakes at most
+//! `k - 1` threads: a pool of 256 running work for one lane wakes none.
 use crate::physics::Exec;
+use crate::physics::exec::{Bound, Busy};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::time::Instant;
 
-/// Data decomposition: `K` threads `pool-0..K-1`, lane `i` on `pool-i`.
+/// Data decomposition: `K` threads `pool-0..K-1`, at most one lane a core.
 pub struct PoolExec {
     pool: rayon::ThreadPool,
     threads: usize,
+    cores: usize,
+    /// The widest section since `take_busy`, and what bound it (`Bound` as
+    /// its index).
+    busy: AtomicUsize,
+    bound: AtomicUsize,
+    /// Nanoseconds spent inside sections of more than one lane, for the
+    /// serial fraction (`ballpit scaling`): two clock reads a section.
+    parallel_ns: AtomicU64,
 }
 
 impl PoolExec {
     pub fn new(threads: usize) -> anyhow::Result<PoolExec> {
         let threads = threads.max(1);
+        // The build error's text is its cause's, and its source that cause
+        // again: say it once, as bad input (exit 2), naming what failed.
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .thread_name(|i| format!("pool-{i}"))
-            .build()?;
-        Ok(PoolExec { pool, threads })
+            .build()
+            .map_err(|e| refused(&format!("{threads} pool threads"), &e))?;
+        let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
+        Ok(PoolExec {
+            pool,
+            threads,
+            cores,
+            busy: AtomicUsize::new(0),
+            bound: AtomicUsize::new(0),
+            parallel_ns: AtomicU64::new(0),
+        })
+    }
+
+    /// Seconds spent so far inside sections that ran on more than one lane.
+    pub fn parallel_seconds(&self) -> f64 {
+        self.parallel_ns.load(Ordering::Relaxed) as f64 * 1e-9
     }
 
     pub fn threads(&self) -> usize {
@@ -29,6 +58,14 @@ impl PoolExec {
     }
 }
 
+/// The system would not start a thread (`ulimit -u`, `ulimit -v`).
+fn refused(what: &str, e: &rayon::ThreadPoolBuildError) -> anyhow::Error {
+    crate::error::BadInput(format!(
+        "cannot start {what}: the system refused a thread ({e}); try fewer --threads or raise ulimit -u / ulimit -v"
+    ))
+    .into()
+}
+
 fn thread_ids(pool: &rayon::ThreadPool) -> Vec<(String, i32)> {
     pool.broadcast(|_| {
         let name = std::thread::current().name().unwrap_or("").to_string();
@@ -39,14 +76,54 @@ fn thread_ids(pool: &rayon::ThreadPool) -> Vec<(String, i32)> {
     .collect()
 }
 
+const BOUNDS: [Bound; 4] = [Bound::Threads, Bound::Cores, Bound::Blocks, Bound::Work];
+
 impl Exec for PoolExec {
     fn lanes(&self) -> usize {
         self.threads
     }
 
+    fn cores(&self) -> usize {
+        self.cores
+    }
+
     fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
-        // One call per pool thread; a panic in any comes back here.
-        self.pool.broadcast(|ctx| f(ctx.index()));
+        self.for_lanes(self.threads, f);
+    }
+
+    fn for_lanes(&self, lanes: usize, f: &(dyn Fn(usize) + Sync)) {
+        if lanes <= 1 {
+            f(0);
+            return;
+        }
+        // Lane 0 on the caller, the others as jobs the idle threads steal;
+        // a panic in any comes back here.
+        let t0 = Instant::now();
+        self.pool.in_place_scope(|s| {
+            for lane in 1..lanes.min(self.threads) {
+                s.spawn(move |_| f(lane));
+            }
+            f(0);
+        });
+        let ns = u64::try_from(t0.elapsed().as_nanos()).unwrap_or(u64::MAX);
+        self.parallel_ns.fetch_add(ns, Ordering::Relaxed);
+    }
+
+    fn note_lanes(&self, lanes: usize, bound: Bound) {
+        if self.busy.fetch_max(lanes, Ordering::Relaxed) < lanes {
+            let i = BOUNDS.iter().position(|&b| b == bound).unwrap_or(0);
+            self.bound.store(i, Ordering::Relaxed);
+        }
+    }
+
+    fn take_busy(&self) -> Option<Busy> {
+        let busy = self.busy.swap(0, Ordering::Relaxed);
+        let bound = BOUNDS[self.bound.swap(0, Ordering::Relaxed).min(3)];
+        (busy > 0).then_some(Busy {
+            busy,
+            threads: self.threads,
+            bound,
+        })
     }
 
     fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {
@@ -79,7 +156,8 @@ impl SplitExec {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(2)
             .thread_name(|i| SPLIT_NAMES[i].to_string())
-            .build()?;
+            .build()
+            .map_err(|e| refused("the two split threads", &e))?;
         Ok(SplitExec { pool })
     }
 

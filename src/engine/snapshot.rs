@@ -4,7 +4,7 @@ use super::Settings;
 use crate::physics::auto::Choice;
 use crate::physics::broad::Grid;
 use crate::physics::discrete::pair_budget;
-use crate::physics::exec::{for_each_block, for_each_chunk};
+use crate::physics::exec::{Busy, for_each_block_of, for_each_chunk};
 use crate::physics::world::escapes;
 use crate::physics::{Counters, Exec, World};
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
@@ -58,6 +58,9 @@ pub struct Snapshot {
     /// A limit the last count or radius command hit, e.g. "radius limit:
     /// spheres touch at r = 0.0310"; kept until the next such command.
     pub notice: Option<String>,
+    /// How many pool lanes the widest section of this frame kept busy, of
+    /// how many threads, and what held it there (`None` off the pool).
+    pub pool_busy: Option<Busy>,
 }
 
 impl Snapshot {
@@ -86,6 +89,7 @@ impl Snapshot {
             steps: 0,
             settings,
             notice: None,
+            pool_busy: None,
         };
         let serial = crate::physics::Serial;
         let overlap = OverlapScratch::default().measure(world, &serial);
@@ -104,6 +108,8 @@ impl Snapshot {
         exec: &dyn Exec,
         views: bool,
     ) {
+        // Read before the copy below, whose sections count toward the next.
+        self.pool_busy = exec.take_busy();
         self.time = world.time;
         self.size = world.size;
         // The copy and the scans run on the frame's executor: at 100 000
@@ -140,7 +146,9 @@ impl Snapshot {
             });
         } else {
             self.spheres = Vec::new();
-            for_each_block(exec, sp.len().div_ceil(VIEW_BLOCK), &|b| scan(b, None));
+            for_each_block_of(exec, sp.len().div_ceil(VIEW_BLOCK), sp.len(), &|b| {
+                scan(b, None);
+            });
         }
         self.count = sp.len();
         self.max_radius = (!sp.is_empty()).then(|| f64::from_bits(widest.into_inner()));

@@ -4,7 +4,7 @@
 //! the two run side by side; otherwise each is cut into blocks over the
 //! lanes (`pool`). Either way the results are the same bits.
 use super::broad::{Grid, Pair};
-use super::exec::{Exec, Serial, for_each_block};
+use super::exec::{Exec, Serial, for_each_block_of};
 use super::sphere::Sphere;
 use glam::DVec3;
 use parking_lot::Mutex;
@@ -52,7 +52,7 @@ impl Detection {
         let slots = &self.walls;
         let limit = self.pair_limit.unwrap_or(usize::MAX);
         let find_walls = |exec: &dyn Exec| {
-            for_each_block(exec, blocks, &|b| {
+            for_each_block_of(exec, blocks, n, &|b| {
                 let mut v = slots[b].lock();
                 v.clear();
                 let end = ((b + 1) * SPHERE_BLOCK).min(n);

@@ -24,6 +24,95 @@ pub trait Exec: Sync {
     fn host(&self, job: &mut (dyn FnMut() + Send)) {
         job();
     }
+    /// Run `f(lane)` for every lane in `0..lanes` (at most `lanes()`), and
+    /// wake no more threads than that. Default: every lane, the rest idle.
+    fn for_lanes(&self, lanes: usize, f: &(dyn Fn(usize) + Sync)) {
+        self.for_each_lane(&|lane| {
+            if lane < lanes {
+                f(lane);
+            }
+        });
+    }
+    /// Most cores the executor's lanes can run on at once (the machine's).
+    fn cores(&self) -> usize {
+        usize::MAX
+    }
+    /// Items of work a lane must have before another is woken; an executor
+    /// that only checks the cut (tests) may say 1 to get every lane.
+    fn min_work(&self) -> usize {
+        MIN_WORK_PER_LANE
+    }
+    /// Told the lanes each section gets and why (see `lanes_of`).
+    fn note_lanes(&self, _lanes: usize, _bound: Bound) {}
+    /// How many lanes the sections since the last call kept busy at most,
+    /// and why not more; `None` for an executor that does not count.
+    fn take_busy(&self) -> Option<Busy> {
+        None
+    }
+}
+
+/// Items of work (spheres, pairs, cluster members) a lane must have before
+/// waking it pays: a sleeping thread takes tens of microseconds to wake and
+/// a sphere's share of a section a few tens of nanoseconds
+/// (docs/threading.md has the measurements behind the figure).
+pub const MIN_WORK_PER_LANE: usize = 4096;
+
+/// What held a parallel section to the lanes it got.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Bound {
+    /// Every thread had work.
+    #[default]
+    Threads,
+    /// More threads than the machine has cores: the rest would only queue.
+    Cores,
+    /// Fewer blocks than threads (blocks are cut by the work, never by the
+    /// thread count, so the answer does not change with it).
+    Blocks,
+    /// Too little work to pay for waking another thread.
+    Work,
+}
+
+/// The widest section of a step: `busy` of `threads` lanes, held by `bound`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Busy {
+    pub busy: usize,
+    pub threads: usize,
+    pub bound: Bound,
+}
+
+/// The lanes a section of `blocks` blocks and `work` items gets from an
+/// executor of `threads` threads on `cores` cores, a lane wanting
+/// `min_work` items: the least of the four limits, at least one, and which
+/// limit it was (the first that binds, in the order work, blocks,
+/// threads, cores).
+#[must_use]
+pub fn lanes_for(
+    threads: usize,
+    cores: usize,
+    blocks: usize,
+    work: usize,
+    min_work: usize,
+) -> (usize, Bound) {
+    let limits = [
+        (work / min_work.max(1), Bound::Work),
+        (blocks, Bound::Blocks),
+        (threads, Bound::Threads),
+        (cores, Bound::Cores),
+    ];
+    let least = limits.iter().map(|l| l.0).min().unwrap_or(1).max(1);
+    let bound = limits
+        .iter()
+        .find(|l| l.0.max(1) == least)
+        .map_or(Bound::Threads, |l| l.1);
+    (least, bound)
+}
+
+/// The lanes `exec` gives a section of `blocks` blocks and `work` items.
+#[must_use]
+pub fn lanes_of(exec: &dyn Exec, blocks: usize, work: usize) -> usize {
+    let (lanes, bound) = lanes_for(exec.lanes(), exec.cores(), blocks, work, exec.min_work());
+    exec.note_lanes(lanes, bound);
+    lanes
 }
 
 /// Everything on the calling thread.
@@ -44,35 +133,35 @@ impl Exec for Serial {
 }
 
 /// Run `f(block, chunk)` for `data` cut into chunks of `block` items, the
-/// chunks spread over lanes.
+/// chunks spread over lanes (one item of data is one item of work).
 pub fn for_each_chunk<T: Send>(
     exec: &dyn Exec,
     data: &mut [T],
     block: usize,
     f: &(dyn Fn(usize, &mut [T]) + Sync),
 ) {
+    let work = data.len();
     let chunks: Vec<parking_lot::Mutex<&mut [T]>> = data
         .chunks_mut(block)
         .map(parking_lot::Mutex::new)
         .collect();
-    for_each_block(exec, chunks.len(), &|b| f(b, &mut chunks[b].lock()));
+    for_each_block_of(exec, chunks.len(), work, &|b| f(b, &mut chunks[b].lock()));
 }
 
-/// Run `f(block)` for every block in `0..blocks`, blocks spread over lanes.
-/// Lanes take the next block as they finish one, so uneven blocks even out;
-/// each block's result is its own, so who ran it never shows.
+/// Run `f(block)` for every block in `0..blocks`, each block counted as
+/// enough work for a lane (see `for_each_block_of`).
 pub fn for_each_block(exec: &dyn Exec, blocks: usize, f: &(dyn Fn(usize) + Sync)) {
-    let lanes = exec.lanes().min(blocks).max(1);
-    if lanes == 1 {
-        (0..blocks).for_each(f);
-        return;
-    }
+    for_each_block_of(exec, blocks, blocks.saturating_mul(MIN_WORK_PER_LANE), f);
+}
+
+/// Run `f(block)` for every block in `0..blocks` (`work` items in all),
+/// blocks spread over the lanes `lanes_for` gives. Lanes take the next block
+/// as they finish one, so uneven blocks even out; each block's result is its
+/// own, so who ran it never shows.
+pub fn for_each_block_of(exec: &dyn Exec, blocks: usize, work: usize, f: &(dyn Fn(usize) + Sync)) {
+    let lanes = lanes_of(exec, blocks, work);
     let next = AtomicUsize::new(0);
-    exec.for_each_lane(&|lane| {
-        if lane < lanes {
-            next_blocks(&next, blocks).for_each(f);
-        }
-    });
+    exec.for_lanes(lanes, &|_| next_blocks(&next, blocks).for_each(f));
 }
 
 /// The blocks one lane takes from a shared counter, until none are left.
@@ -81,4 +170,29 @@ pub fn next_blocks(next: &AtomicUsize, blocks: usize) -> impl Iterator<Item = us
         let b = next.fetch_add(1, Ordering::Relaxed);
         (b < blocks).then_some(b)
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Bound, MIN_WORK_PER_LANE, lanes_for};
+
+    #[test]
+    fn lanes_follow_the_tightest_limit() {
+        let w = MIN_WORK_PER_LANE;
+        // An executor that wants every lane (tests of the cut) gets them.
+        assert_eq!(lanes_for(8, 8, 100, 10, 1), (8, Bound::Threads));
+        // The default scene: 1000 spheres on 64 threads stay on one lane.
+        assert_eq!(lanes_for(64, 2, 1, 1000, w), (1, Bound::Work));
+        assert_eq!(lanes_for(256, 2, 40, 1000, w), (1, Bound::Work));
+        // Enough work, few blocks.
+        assert_eq!(lanes_for(64, 64, 3, 100 * w, w), (3, Bound::Blocks));
+        // Enough of both: the cores, then the threads.
+        assert_eq!(lanes_for(64, 2, 100, 100 * w, w), (2, Bound::Cores));
+        assert_eq!(lanes_for(8, 64, 100, 100 * w, w), (8, Bound::Threads));
+        // Work for exactly three lanes.
+        assert_eq!(lanes_for(8, 8, 100, 3 * w + 1, w), (3, Bound::Work));
+        // Never none, whatever the limits.
+        assert_eq!(lanes_for(0, 0, 0, 0, w).0, 1);
+        assert_eq!(lanes_for(1, 2, 100, 100 * w, w), (1, Bound::Threads));
+    }
 }

@@ -29,6 +29,21 @@ pub struct Threads<'a> {
     pub palette: Palette,
     /// Busiest first (key `s`) instead of the fixed order.
     pub by_cpu: bool,
+    /// `pool_line` of the last frame, when a pool ran it.
+    pub pool: Option<String>,
+}
+
+/// How many pool threads the scene keeps busy, and why no more, e.g.
+/// `pool: 1 of 64 busy — 1000 spheres too few` (short, to fit the panel).
+pub fn pool_line(b: &crate::physics::exec::Busy, spheres: usize) -> String {
+    use crate::physics::exec::Bound;
+    let why = match b.bound {
+        Bound::Work => format!("{spheres} spheres too few"),
+        Bound::Blocks => "too few blocks".into(),
+        Bound::Cores => "one a core".into(),
+        Bound::Threads => "all".into(),
+    };
+    format!("pool: {} of {} busy — {why}", b.busy, b.threads)
 }
 
 /// `values` (percent of one core) as bars, newest last, at most `width`,
@@ -150,6 +165,7 @@ pub fn full_height(report: &CpuReport) -> u16 {
         report,
         palette: Palette::Mono,
         by_cpu: false,
+        pool: None,
     };
     t.lines(usize::from(u16::MAX)).len() as u16 + 2
 }
@@ -161,6 +177,7 @@ pub fn compact_height(report: &CpuReport, inner_width: usize) -> u16 {
         report,
         palette: Palette::Mono,
         by_cpu: false,
+        pool: None,
     };
     t.compact_lines(inner_width, usize::MAX).len() as u16 + 2
 }
@@ -461,11 +478,16 @@ impl Widget for Threads<'_> {
         let inner = block.inner(area);
         block.render(area, buf);
         let (w, h) = (usize::from(inner.width), usize::from(inner.height));
-        let lines = match self.layout(w, h) {
+        let mut lines = match self.layout(w, h) {
             Layout::Rows => self.lines(w),
             Layout::Columns => self.column_lines(w),
             Layout::Grid => self.compact_lines(w, h),
         };
+        // The pool's line above the process and other-procs totals, where a row is spare.
+        if let Some(p) = self.pool.clone().filter(|_| h > lines.len()) {
+            let at = lines.len().saturating_sub(2);
+            lines.insert(at, Line::from(Span::styled(p, self.palette.label())));
+        }
         Paragraph::new(lines).render(inner, buf);
     }
 }

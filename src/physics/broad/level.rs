@@ -237,7 +237,7 @@ impl Level {
         } else {
             exec
         };
-        let lanes = exec.lanes().clamp(1, 64).min(cells);
+        let lanes = super::super::exec::lanes_of(exec, cells, staged.keys().len()).min(64);
         let bounds: Vec<usize> = (0..=lanes).map(|l| l * cells / lanes).collect();
         let mut tables: Vec<Mutex<&mut [u32]>> = Vec::with_capacity(lanes);
         let mut rest = &mut self.cell_start[..cells];
@@ -256,8 +256,8 @@ impl Level {
         let layer = self.side * self.side;
         self.layers.resize_with(lanes, Default::default);
         let layers = &self.layers;
-        exec.for_each_lane(&|l| {
-            if l >= lanes || counted.is_some() {
+        exec.for_lanes(lanes, &|l| {
+            if counted.is_some() {
                 return;
             }
             let (lo, hi) = (bounds[l] as u32, bounds[l + 1] as u32);
@@ -316,10 +316,7 @@ impl Level {
             regions.push(Mutex::new(mine));
             rest = more;
         }
-        exec.for_each_lane(&|l| {
-            if l >= lanes {
-                return;
-            }
+        exec.for_lanes(lanes, &|l| {
             let (lo, hi) = (bounds[l] as u32, bounds[l + 1] as u32);
             let mut table = tables[l].lock();
             let mut region = regions[l].lock();

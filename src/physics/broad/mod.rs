@@ -8,7 +8,7 @@
 //! scenes use all pairs.
 mod level;
 
-use super::exec::{Exec, for_each_block, for_each_chunk};
+use super::exec::{Exec, for_each_block_of, for_each_chunk};
 use super::sphere::Sphere;
 use glam::DVec3;
 use level::{Ball, Entry, Level, Source, within};
@@ -299,6 +299,11 @@ impl Grid {
         }
     }
 
+    /// Entries over all levels: the work of a pass over the units.
+    fn entries(&self) -> usize {
+        self.levels.iter().map(|l| l.entries.len()).sum::<usize>() + self.top.len()
+    }
+
     fn units(&self) -> Vec<Unit> {
         let mut units = Vec::new();
         for (l, level) in self.levels.iter().enumerate() {
@@ -377,7 +382,7 @@ impl Grid {
             self.slots.push(Mutex::new(Vec::new()));
         }
         let this = &*self;
-        for_each_block(exec, units.len(), &|u| {
+        for_each_block_of(exec, units.len(), this.entries(), &|u| {
             let mut v = this.slots[u].lock();
             v.clear();
             this.unit_pairs(units[u], &|| true, &mut |i, j| {
@@ -444,7 +449,7 @@ impl Grid {
         }
         let this = &*self;
         let found = AtomicUsize::new(0);
-        for_each_block(exec, units.len(), &|u| {
+        for_each_block_of(exec, units.len(), this.entries(), &|u| {
             let mut v = STORE.then(|| this.slots[u].lock());
             if let Some(v) = &mut v {
                 v.clear();

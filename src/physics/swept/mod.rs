@@ -28,7 +28,7 @@ mod rounds;
 use super::broad::Pair;
 use super::contact::pair_toi;
 use super::detect::{Detection, SPHERE_BLOCK};
-use super::exec::{Exec, for_each_block, for_each_chunk};
+use super::exec::{Exec, for_each_block_of, for_each_chunk};
 use super::flight::fly;
 use super::model::{Model, ModelKind};
 use super::sphere::Sphere;
@@ -342,7 +342,7 @@ impl Swept {
             self.overlap.push(Mutex::new(0.0));
         }
         let (sorted, overlap) = (&self.sorted, &self.overlap);
-        for_each_block(exec, blocks, &|b| {
+        for_each_block_of(exec, blocks, pairs.len(), &|b| {
             let mut guard = sorted[b].lock();
             let (meets, near) = &mut *guard;
             meets.clear();

@@ -30,7 +30,7 @@ use super::cluster::{Chunk, Coarse, Member, Run, Shared};
 use super::conflicts::{Conflicts, Finished};
 use super::partition::{Batch, Partition, Slot};
 use crate::physics::broad::Grid;
-use crate::physics::exec::{Exec, Serial, next_blocks};
+use crate::physics::exec::{Exec, Serial, lanes_of, next_blocks};
 use crate::physics::sphere::Sphere;
 use parking_lot::Mutex;
 use std::sync::atomic::AtomicUsize;
@@ -282,14 +282,11 @@ impl Rounds {
 
     fn run_clusters(&self, exec: &dyn Exec, sh: &Shared, absorb: bool) {
         let blocks = self.batch.todo.len().div_ceil(CLUSTER_BLOCK);
-        let lanes = exec.lanes().clamp(1, blocks.max(1));
         let (runs, outs, todo) = (&self.runs, &self.outs, &self.batch.todo);
         let (order, pairs) = (&self.batch.order, &self.batch.pairs);
+        let lanes = lanes_of(exec, blocks, order.len());
         let next = AtomicUsize::new(0);
-        exec.for_each_lane(&|lane| {
-            if lane >= lanes {
-                return;
-            }
+        exec.for_lanes(lanes, &|lane| {
             let mut run = runs[lane].lock();
             for b in next_blocks(&next, blocks) {
                 let mut out = outs[b].lock();
