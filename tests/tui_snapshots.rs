@@ -51,6 +51,7 @@ fn stats() -> Stats {
         detected: Some(Palette::True),
         link: None,
         link_slow: false,
+        ..Stats::default()
     }
 }
 

@@ -6,12 +6,14 @@ use crossterm::event::{KeyCode, KeyEvent, KeyEventKind, KeyModifiers};
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Action {
     Quit,
-    /// Esc: closes the help if it is open, else quits.
+    /// Esc: closes the help if it is open, else the chart, else quits.
     Escape,
     ToggleThreading,
     CycleThreadedMode,
     FewerThreads,
     MoreThreads,
+    /// Flat out (tick `max`) on/off, back to the tick before.
+    FlatOut,
     TickDown,
     TickUp,
     Pause,

@@ -6,7 +6,8 @@ use super::projection::Camera;
 use crate::engine::{Command, MAX_THREADS, Settings, Snapshot, Threading};
 use crate::physics::ModelKind;
 
-pub const MAX_TICK: u32 = 1000;
+/// The most steps a frame runs, for `--tick` and the keys alike.
+pub const MAX_TICK: u32 = 1_000_000;
 pub const MAX_COUNT: usize = 1 << 21;
 pub const MIN_RADIUS: f64 = 1e-4;
 pub const RADIUS_STEP: f64 = 1.25;
@@ -22,6 +23,12 @@ pub struct AppState {
     pub last_threaded: Threading,
     pub threads: usize,
     pub tick: u32,
+    /// Flat out (`--tick max`, key x): each frame runs as many steps as its
+    /// time allows; `tick` is kept to go back to.
+    pub flat_out: bool,
+    /// Counts the changes of scene (count, radius, model, reset), so
+    /// figures measured on one scene are not compared with another's.
+    pub scene: u64,
     pub paused: bool,
     pub model: ModelKind,
     pub count: usize,
@@ -49,6 +56,8 @@ impl AppState {
             },
             threads: settings.threads.max(1),
             tick: settings.tick,
+            flat_out: false,
+            scene: 0,
             paused: false,
             model: settings.model,
             count,
@@ -66,7 +75,17 @@ impl AppState {
 
     /// Whether frames should step the physics.
     pub fn running(&self) -> bool {
-        !self.paused && self.tick > 0
+        !self.paused && (self.flat_out || self.tick > 0)
+    }
+
+    /// The tick the engine runs with: flat out needs a tick above 0 (the
+    /// frame's time budget, not the tick, says how many steps).
+    pub fn engine_tick(&self) -> u32 {
+        if self.flat_out {
+            self.tick.max(1)
+        } else {
+            self.tick
+        }
     }
 
     /// Do one key; returns what the engine must be told.
@@ -79,6 +98,8 @@ impl AppState {
             Action::Escape => {
                 if self.help {
                     self.help = false;
+                } else if self.chart {
+                    self.chart = false;
                 } else {
                     self.quit = true;
                 }
@@ -130,6 +151,24 @@ impl AppState {
                             Some(format!("pool threads {want}: exact runs on one thread"));
                     }
                 }
+            }
+            Action::FlatOut => {
+                self.flat_out = !self.flat_out;
+                self.notice = Some(if self.flat_out {
+                    format!(
+                        "flat out: as many steps as each frame allows (x: back to tick {})",
+                        self.tick
+                    )
+                } else {
+                    format!("flat out off: tick {}", self.tick)
+                });
+                self.tell_if_paused();
+            }
+            Action::TickDown | Action::TickUp if self.flat_out => {
+                self.notice = Some(format!(
+                    "flat out sets the steps; x goes back to tick {}",
+                    self.tick
+                ));
             }
             Action::TickDown => {
                 if self.tick == 0 {
@@ -206,6 +245,19 @@ impl AppState {
                 }
             },
         }
+        if !out.is_empty()
+            && matches!(
+                action,
+                Action::HalveCount
+                    | Action::DoubleCount
+                    | Action::Smaller
+                    | Action::Bigger
+                    | Action::CycleModel
+                    | Action::Reset
+            )
+        {
+            self.scene += 1;
+        }
         if self.chart
             && matches!(
                 action,
@@ -222,9 +274,19 @@ impl AppState {
         out
     }
 
+    /// The mode as flat out's comparison names it (a pool with its size).
+    pub fn mode_label(&self) -> String {
+        match self.threading {
+            Threading::Pool => format!("pool {}", self.threads),
+            t => t.name().to_string(),
+        }
+    }
+
     /// The tick is kept while paused; it runs on resume.
     fn tell_if_paused(&mut self) {
-        if self.paused {
+        if self.paused && self.flat_out {
+            self.notice = Some("flat out: runs when resumed (space)".into());
+        } else if self.paused {
             self.notice = Some(format!("tick {}: runs when resumed (space)", self.tick));
         }
     }
