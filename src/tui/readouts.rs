@@ -138,8 +138,25 @@ impl Readouts<'_> {
     }
 
     /// The radius in force: the snapshot's, never the one asked for.
-    fn radius(&self) -> String {
-        representative_radius(self.snap).map_or_else(|| "-".into(), |r| format!("{r:.5}"))
+    /// A mixed scene shows its range, smallest to largest.
+    fn radius(&self, compact: bool) -> String {
+        let Some(max) = representative_radius(self.snap) else {
+            return "-".into();
+        };
+        match self.snap.min_radius {
+            Some(min) if min < max && compact => format!("{min:.3}-{max:.3}"),
+            Some(min) if min < max => format!("{min:.5}-{max:.5}"),
+            _ => format!("{max:.5}"),
+        }
+    }
+
+    /// Simulated seconds per second: steps/s times dt, so `f`/`F` (and
+    /// the tick) explain the speed they change.
+    fn sim_speed(&self) -> String {
+        format!(
+            "sim {:.2} s/s",
+            self.stats.steps_per_second * self.snap.settings.dt
+        )
     }
 
     /// A frame that has run longer than a few periods, as "N steps, T s".
@@ -235,12 +252,19 @@ impl Readouts<'_> {
             tick = format!("{:<8} flat out (x: tick {})", "max", s.tick);
         } else if s.tick == 0 {
             tick.push_str("  frozen");
+        } else {
+            tick = format!(
+                "{} step{}/frame  {}",
+                s.tick,
+                if s.tick == 1 { "" } else { "s" },
+                self.sim_speed()
+            );
         }
         vec![
             row("threading", self.threading()),
             row("tick", tick),
             row("count", format!("{}", snap.count)),
-            row("radius", self.radius()),
+            row("radius", self.radius(false)),
             row("model", model_row(s.model, snap.parts)),
             row("style", s.style.name().to_string()),
             row("colour", self.colour()),
@@ -266,7 +290,7 @@ impl Readouts<'_> {
             row("vs off", self.comparison()),
             row(
                 "drift",
-                format!("{:<8.1e} energy since reset", snap.energy_drift()),
+                format!("{:<8.1e} energy vs start/edit", snap.energy_drift()),
             ),
             row(
                 "overlap",
@@ -322,7 +346,7 @@ impl Readouts<'_> {
                 "count",
                 snap.count.to_string(),
             ),
-            pair("radius", self.radius(), "model", model),
+            pair("radius", self.radius(true), "model", model),
             pair("fps", self.fps(true), "physics", self.physics_ms()),
             match (&st.link, st.link_slow) {
                 (Some(link), true) => Line::from(vec![

@@ -347,6 +347,10 @@ impl FrameLoop {
                 self.engine.command(Command::SetTick(tick));
                 self.sent_tick = tick;
             }
+            if self.pending {
+                // The key's answer first: applying it may take long (N).
+                self.present()?;
+            }
             let budget = self.state.flat_out;
             self.engine
                 .set_budget(budget.then(|| self.stats.flat_out_budget(&self.state)));

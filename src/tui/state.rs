@@ -10,6 +10,8 @@ use crate::physics::ModelKind;
 pub const MAX_TICK: u32 = 1_000_000;
 pub const MAX_COUNT: usize = 1 << 21;
 pub const MIN_RADIUS: f64 = 1e-4;
+/// A count from which placing the spheres takes long enough to say so.
+pub const BIG_EDIT: usize = 100_000;
 pub const RADIUS_STEP: f64 = 1.25;
 pub const CAMERA_STEP: f64 = std::f64::consts::PI / 18.0;
 pub const MAX_PITCH: f64 = 1.5;
@@ -43,6 +45,9 @@ pub struct AppState {
     pub quit: bool,
     /// A limit a key ran into, shown until the next key.
     pub notice: Option<String>,
+    /// The notice says work is under way (placing spheres): the frame that
+    /// does it ends it.
+    pub under_way: bool,
 }
 
 impl AppState {
@@ -70,6 +75,7 @@ impl AppState {
             fps,
             quit: false,
             notice: None,
+            under_way: false,
         }
     }
 
@@ -92,6 +98,7 @@ impl AppState {
     #[allow(clippy::too_many_lines)] // one arm a key, as the key table lists them
     pub fn apply(&mut self, action: Action) -> Vec<Command> {
         self.notice = None;
+        self.under_way = false;
         let mut out = Vec::new();
         match action {
             Action::Quit => self.quit = true,
@@ -201,6 +208,10 @@ impl AppState {
                 } else {
                     self.count = (self.count * 2).max(1);
                     out.push(Command::SetCount(self.count));
+                    if self.count >= BIG_EDIT {
+                        self.notice = Some(format!("placing {} spheres...", self.count));
+                        self.under_way = true;
+                    }
                 }
             }
             Action::Smaller => {
@@ -232,7 +243,10 @@ impl AppState {
                 }
             }
             Action::Chart => self.chart = !self.chart,
-            Action::Reset => out.push(Command::Reset),
+            Action::Reset => {
+                out.push(Command::Reset);
+                self.notice = Some("reset: the scene as it started".into());
+            }
             Action::Help => self.help = !self.help,
             Action::SlowerFps => match FPS_STEPS.iter().rev().find(|&&f| f < self.fps - 1e-9) {
                 Some(&f) => self.fps = f,
@@ -299,8 +313,15 @@ impl AppState {
         if let Some(r) = representative_radius(snap) {
             self.radius = r;
         }
+        // The engine's notice (a limit it hit) answers the commands; with
+        // none, the key's own notice stays, unless it said work was under way.
         if applied {
-            self.notice.clone_from(&snap.notice);
+            if snap.notice.is_some() {
+                self.notice.clone_from(&snap.notice);
+            } else if self.under_way {
+                self.notice = None;
+            }
+            self.under_way = false;
         }
     }
 }
