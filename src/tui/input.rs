@@ -97,6 +97,7 @@ mod tests {
             (KeyCode::Char('f'), Action::SlowerFps),
             (KeyCode::Char('F'), Action::FasterFps),
             (KeyCode::Char('c'), Action::Chart),
+            (KeyCode::Char('x'), Action::FlatOut),
         ];
         for (code, want) in table {
             assert_eq!(action(press(code)), Some(want), "{code:?}");
@@ -108,7 +109,7 @@ mod tests {
             KeyModifiers::CONTROL | KeyModifiers::SHIFT,
         );
         assert_eq!(action(ctrl_shift_c), Some(Action::Quit));
-        assert_eq!(action(press(KeyCode::Char('x'))), None);
+        assert_eq!(action(press(KeyCode::Char('y'))), None);
         let ctrl_t = KeyEvent::new(KeyCode::Char('t'), KeyModifiers::CONTROL);
         assert_eq!(action(ctrl_t), None);
         let mut release = press(KeyCode::Char('q'));

@@ -245,7 +245,7 @@ impl AppState {
             Action::Chart => self.chart = !self.chart,
             Action::Reset => {
                 out.push(Command::Reset);
-                self.notice = Some("reset: the scene as it started".into());
+                self.notice = Some("scene back to its start".into());
             }
             Action::Help => self.help = !self.help,
             Action::SlowerFps => match FPS_STEPS.iter().rev().find(|&&f| f < self.fps - 1e-9) {
