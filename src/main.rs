@@ -23,10 +23,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Bench(args)) => {
             let mut settings = args.run.settings()?;
-            settings.tick = args
-                .run
-                .tick
-                .unwrap_or_else(|| args.steps.div_ceil(100).clamp(1, u64::from(u32::MAX)) as u32);
+            settings.tick = args.run.bench_tick(args.steps)?;
             let world = scene::build_world_for(&args.scene.spec(), Some(settings.model))?;
             fits(world.spheres.len(), Some(settings.model))?;
             let dump = args

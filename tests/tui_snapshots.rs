@@ -51,6 +51,7 @@ fn stats() -> Stats {
         detected: Some(Palette::True),
         link: None,
         link_slow: false,
+        ..Stats::default()
     }
 }
 
@@ -594,11 +595,11 @@ fn chart_view_has_a_line_per_thread_and_groups_many() {
 #[test]
 fn readouts_show_the_radius_in_force_not_the_one_asked_for() {
     let mut st = state();
-    // Asked for 0.5; the snapshot's largest sphere is 0.15.
+    // Asked for 0.5; the snapshot's spheres span 0.08 to 0.15.
     st.radius = 0.5;
     let t = readouts(&st, &snapshot(), Palette::C16);
     let text = rows(&t).join("\n");
-    assert!(text.contains("radius     0.15000"), "{text}");
+    assert!(text.contains("radius     0.08000-0.15000"), "{text}");
     assert!(!text.contains("0.50000"), "{text}");
 }
 

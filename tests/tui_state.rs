@@ -268,6 +268,8 @@ fn sync_takes_the_real_count_radius_and_the_engine_notice() {
     snap.notice = None;
     a.sync(&snap, false);
     assert!(a.notice.is_some());
+    // The next key's frame, with no limit hit, leaves no notice.
+    key(&mut a, KeyCode::Char('n'));
     a.sync(&snap, true);
     assert!(a.notice.is_none());
 }
@@ -317,4 +319,58 @@ fn tick_keys_while_paused_say_the_tick_runs_on_resume() {
     key(&mut a, KeyCode::Char(']'));
     assert_eq!(a.tick, 2);
     assert!(a.notice.as_deref().unwrap().contains("resumed"));
+}
+
+#[test]
+fn x_toggles_flat_out_and_goes_back_to_the_tick_before() {
+    let mut a = app();
+    a.tick = 0;
+    assert!(!a.running());
+    key(&mut a, KeyCode::Char('x'));
+    assert!(a.flat_out && a.running());
+    // Flat out needs a tick above 0 for the engine; the tick is kept.
+    assert_eq!((a.tick, a.engine_tick()), (0, 1));
+    assert!(a.notice.as_deref().unwrap().contains("flat out"));
+    // The tick keys leave the tick alone while flat out, and say so.
+    key(&mut a, KeyCode::Char(']'));
+    assert_eq!(a.tick, 0);
+    assert!(a.notice.as_deref().unwrap().contains("x goes back"));
+    key(&mut a, KeyCode::Char('x'));
+    assert!(!a.flat_out && !a.running());
+}
+
+#[test]
+fn esc_closes_the_help_then_the_chart_then_quits() {
+    let mut a = app();
+    a.help = true;
+    a.chart = true;
+    key(&mut a, KeyCode::Esc);
+    assert!(!a.help && a.chart && !a.quit);
+    key(&mut a, KeyCode::Esc);
+    assert!(!a.chart && !a.quit);
+    key(&mut a, KeyCode::Esc);
+    assert!(a.quit);
+}
+
+#[test]
+fn a_key_that_does_nothing_yet_keeps_its_notice_through_the_frame() {
+    let mut a = app();
+    let mut snap = ballpit::engine::Engine::new(
+        ballpit::scene::build_world(&ballpit::scene::SceneSpec::default()).unwrap(),
+        settings(),
+    )
+    .unwrap()
+    .snapshot()
+    .clone();
+    snap.notice = None;
+    key(&mut a, KeyCode::Char('P'));
+    a.sync(&snap, true);
+    assert!(a.notice.as_deref().unwrap().contains("kept for pool mode"));
+    key(&mut a, KeyCode::Char('0'));
+    a.sync(&snap, true);
+    assert!(a.notice.as_deref().unwrap().contains("back to its start"));
+    // Changes of scene are counted, so flat out's comparison starts again.
+    let before = a.scene;
+    key(&mut a, KeyCode::Char('n'));
+    assert_eq!(a.scene, before + 1);
 }

@@ -129,10 +129,11 @@ pub struct RunArgs {
     /// Step length in seconds (> 0), a number or a fraction such as 1/120
     #[arg(long, default_value = "1/60", value_name = "DT", value_parser = parse_seconds)]
     pub dt: f64,
-    /// Steps per rendered frame (0 freezes) [default: 1]; for bench, steps
-    /// per engine frame [default: a hundredth of --steps]
-    #[arg(long, value_name = "N")]
-    pub tick: Option<u32>,
+    /// Steps per rendered frame (0 freezes; at most 1000000), or `max`:
+    /// flat out, as many steps as the frame rate allows (key x) [default: 1];
+    /// for bench, steps per engine frame [default: a hundredth of --steps]
+    #[arg(long, value_name = "N|max", value_parser = values::parse_tick)]
+    pub tick: Option<values::Tick>,
     /// Collision model
     #[arg(long, value_enum, default_value_t = ModelArg::Swept, value_name = "MODEL")]
     pub model: ModelArg,
@@ -199,6 +200,7 @@ impl Cli {
         crate::tui::Options {
             fps: self.fps,
             color: self.color.into(),
+            flat_out: self.run.tick == Some(values::Tick::Max),
         }
     }
 }
@@ -258,6 +260,18 @@ impl SceneArgs {
 }
 
 impl RunArgs {
+    /// Steps per engine frame for `bench`: `--tick`, else a hundredth of
+    /// the run. Flat out is the screen's: a bench runs a set number of steps.
+    pub fn bench_tick(&self, steps: u64) -> Result<u32, BadInput> {
+        match self.tick {
+            Some(values::Tick::Max) => {
+                bad!("--tick max is for the screen; bench runs --steps steps in frames of --tick N")
+            }
+            Some(values::Tick::Steps(n)) => Ok(n),
+            None => Ok(steps.div_ceil(100).clamp(1, u64::from(u32::MAX)) as u32),
+        }
+    }
+
     pub fn settings(&self) -> Result<Settings, BadInput> {
         if !(self.dt.is_finite() && self.dt > 0.0) {
             return bad!("--dt must be a finite number > 0, got {}", self.dt);
@@ -281,7 +295,8 @@ impl RunArgs {
         Ok(Settings {
             model,
             dt: self.dt,
-            tick: self.tick.unwrap_or(1),
+            // Flat out keeps tick 1 to go back to (key x).
+            tick: self.tick.and_then(values::Tick::steps).unwrap_or(1),
             threading: self.threading.into(),
             threads,
         })

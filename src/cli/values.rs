@@ -2,6 +2,7 @@
 //! and the parsers of `--dt` and `--fps`.
 use crate::engine::Threading;
 use crate::physics::ModelKind;
+use crate::tui::state::MAX_TICK;
 use crate::tui::{ColorChoice, MAX_FPS};
 use clap::ValueEnum;
 use std::time::Duration;
@@ -81,6 +82,37 @@ impl From<ColorArg> for ColorChoice {
         }
     }
 }
+/// `--tick`: steps per frame, or `max` (flat out: as many steps as the
+/// frame period allows).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tick {
+    Steps(u32),
+    Max,
+}
+
+impl Tick {
+    /// The steps a frame runs; `None` for flat out.
+    pub fn steps(self) -> Option<u32> {
+        match self {
+            Tick::Steps(n) => Some(n),
+            Tick::Max => None,
+        }
+    }
+}
+
+/// `max`, or a whole number of steps up to the limit the keys share.
+pub(super) fn parse_tick(s: &str) -> Result<Tick, String> {
+    if s == "max" {
+        return Ok(Tick::Max);
+    }
+    match s.parse::<u32>() {
+        Ok(n) if n <= MAX_TICK => Ok(Tick::Steps(n)),
+        _ => Err(format!(
+            "expected `max` or a whole number of steps from 0 to {MAX_TICK}"
+        )),
+    }
+}
+
 /// A number of seconds, written as a number (0.01) or a fraction (1/60);
 /// whether it is allowed is for the validators to say.
 pub(super) fn parse_seconds(s: &str) -> Result<f64, String> {
@@ -152,6 +184,18 @@ mod tests {
                 .contains("above 0 and at most 1000")
         );
         assert!(parse_fps("1e-30").unwrap_err().contains("too small"));
+    }
+
+    #[test]
+    fn tick_takes_max_or_steps_up_to_the_keys_limit() {
+        assert_eq!(parse_tick("max"), Ok(Tick::Max));
+        assert_eq!(parse_tick("0"), Ok(Tick::Steps(0)));
+        assert_eq!(parse_tick("1000000"), Ok(Tick::Steps(MAX_TICK)));
+        for bad in ["1000001", "-1", "MAX", "1.5", "", "maximum"] {
+            assert!(parse_tick(bad).is_err(), "{bad}");
+        }
+        assert_eq!(Tick::Max.steps(), None);
+        assert_eq!(Tick::Steps(7).steps(), Some(7));
     }
 
     #[test]

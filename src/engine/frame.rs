@@ -2,9 +2,10 @@
 //! world, the model, the executor, and the back snapshot to fill.
 use super::Settings;
 use super::snapshot::{Overlap, OverlapScratch, Snapshot};
-use crate::physics::{Exec, Model, World};
+use crate::physics::{Exec, Model, ModelKind, World};
 use std::sync::Arc;
-use std::time::Instant;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
 
 /// An executor that can travel with the frame to the physics thread.
 pub(crate) type SharedExec = Arc<dyn Exec + Send + Sync>;
@@ -21,6 +22,12 @@ pub(crate) struct Frame {
     pub snap: Snapshot,
     /// Whether the snapshot carries the spheres (a headless run needs none).
     pub views: bool,
+    /// Flat out: step until this much time has passed (at least one step)
+    /// instead of `tick` steps.
+    pub budget: Option<Duration>,
+    /// Steps done so far in the frame under way, for the screen to read
+    /// while a long frame runs.
+    pub progress: Arc<AtomicU64>,
     scratch: OverlapScratch,
 }
 
@@ -44,6 +51,8 @@ impl Frame {
             notice: None,
             snap,
             views,
+            budget: None,
+            progress: Arc::default(),
             scratch: OverlapScratch::default(),
         }
     }
@@ -61,10 +70,8 @@ impl Frame {
     /// (DESIGN.md: `wall_seconds` covers any detection for the readouts).
     /// Copying the spheres out for the screen is not timed.
     fn run_here(&mut self) {
-        let steps = u64::from(self.settings.tick);
         let t0 = Instant::now();
-        self.model
-            .advance(&mut self.world, self.settings.dt, steps, &*self.exec);
+        let steps = self.step(t0);
         let overlap = self
             .model
             .max_overlap_rel(&self.world, self.settings.dt, &*self.exec)
@@ -90,4 +97,46 @@ impl Frame {
         snap.choice = self.model.choice().cloned();
         snap.notice.clone_from(&self.notice);
     }
+
+    /// Run the frame's steps in whole chunks, each sized from the mean step
+    /// so far: `tick` steps, or as many as `budget` allows (at least one).
+    /// Chunks let a long frame report its progress and flat out stop near
+    /// its budget; the models give the same bits however the steps are cut.
+    fn step(&mut self, t0: Instant) -> u64 {
+        let dt = self.settings.dt;
+        let tick = u64::from(self.settings.tick);
+        let budget = self.budget.filter(|_| tick > 0);
+        // `exact` gives other bits when its steps are cut differently, so
+        // it steps one at a time flat out (a state then depends on the
+        // step count alone) and runs a tick in one piece, as it always did.
+        let cuts_freely = self.settings.model != ModelKind::Exact;
+        let (mut done, mut chunk) = (0_u64, if cuts_freely { 1 } else { tick });
+        self.progress.store(0, Ordering::Relaxed);
+        loop {
+            let want = if budget.is_some() {
+                if cuts_freely { chunk } else { 1 }
+            } else {
+                chunk.min(tick - done)
+            };
+            if want == 0 {
+                return done;
+            }
+            self.model.advance(&mut self.world, dt, want, &*self.exec);
+            done += want;
+            self.progress.store(done, Ordering::Relaxed);
+            let spent = t0.elapsed();
+            let left = match budget.map(|b| b.checked_sub(spent)) {
+                Some(None | Some(Duration::ZERO)) => return done,
+                Some(Some(left)) => left,
+                None => PROGRESS_SLICE,
+            };
+            // A quarter of what is left: the step time varies, and an
+            // overshoot past the budget costs the screen its frame.
+            let per_step = spent.as_secs_f64() / done as f64;
+            chunk = (left.as_secs_f64() / 4.0 / per_step.max(1e-9)).max(1.0) as u64;
+        }
+    }
 }
+
+/// How often a long frame of `tick` steps updates its progress.
+const PROGRESS_SLICE: Duration = Duration::from_millis(100);

@@ -30,6 +30,8 @@ use rand::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 use start::Start;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
 use strum::{Display, EnumCount, EnumString, IntoStaticStr};
 pub use worker::Notify;
 use worker::Worker;
@@ -159,6 +161,11 @@ pub struct Engine {
     split: Option<Arc<SplitExec>>,
     failed: Option<String>,
     rng: Xoshiro256PlusPlus,
+    /// Flat out: each frame steps for this long (see [`Engine::set_budget`]).
+    budget: Option<Duration>,
+    /// The frame's step counter, and when the frame in flight started.
+    progress: Arc<AtomicU64>,
+    started: Instant,
 }
 
 impl Engine {
@@ -215,6 +222,7 @@ impl Engine {
         let serial: SharedExec = Arc::new(Serial);
         let (start_radius, start_speed) = (edit::typical_radius(&world), edit::rms_speed(&world));
         let frame = Frame::new(world, model, serial.clone(), settings, views);
+        let progress = frame.progress.clone();
         Ok(Engine {
             front: frame.snap.clone(),
             home: Some(Box::new(frame)),
@@ -230,6 +238,9 @@ impl Engine {
             split: None,
             failed: None,
             rng: Xoshiro256PlusPlus::seed_from_u64(EDIT_SEED),
+            budget: None,
+            progress,
+            started: Instant::now(),
         })
     }
 
@@ -237,6 +248,14 @@ impl Engine {
     /// last `start_frame` are not in yet).
     pub fn settings(&self) -> &Settings {
         &self.settings
+    }
+
+    /// Flat out: from the next frame on, each frame runs whole steps until
+    /// `budget` has passed (at least one, none while the tick is 0) in
+    /// place of `tick` steps; `None` goes back to `tick`. The frame loop
+    /// sets it from the frame period, so the screen keeps its rate.
+    pub fn set_budget(&mut self, budget: Option<Duration>) {
+        self.budget = budget;
     }
 
     /// Queue a change for the next frame boundary.
@@ -261,6 +280,7 @@ impl Engine {
             self.home = Some(frame);
             return Err(e);
         }
+        frame.budget = self.budget;
         if self.settings.threading == Threading::Off {
             let frame = worker::run_caught(frame).map_err(|e| self.fail(e))?;
             self.land(frame);
@@ -269,6 +289,7 @@ impl Engine {
                 .start(frame)
                 .map_err(|e| self.fail(e.to_string()))?;
             self.in_flight = true;
+            self.started = Instant::now();
         }
         Ok(())
     }
@@ -322,6 +343,17 @@ impl Engine {
     /// so a caller waiting on something else can collect it at once.
     pub fn set_notify(&self, f: Notify) {
         self.worker.set_notify(f);
+    }
+
+    /// A threaded frame still computing: the steps it has done so far and
+    /// how long it has run (the screen says a long frame is under way).
+    pub fn under_way(&self) -> Option<(u64, Duration)> {
+        (self.in_flight && !self.worker.ready()).then(|| {
+            (
+                self.progress.load(Ordering::Relaxed),
+                self.started.elapsed(),
+            )
+        })
     }
 
     /// Whether a threaded frame is being computed.

@@ -34,6 +34,8 @@ pub struct Snapshot {
     pub count: usize,
     /// The largest radius, exactly (`None` for an empty box).
     pub max_radius: Option<f64>,
+    /// The smallest radius (`None` for an empty box): a mixed scene's range.
+    pub min_radius: Option<f64>,
     pub energy: f64,
     /// Energy right after the last reset (or scene start), for the drift.
     pub energy_reset: f64,
@@ -77,6 +79,7 @@ impl Snapshot {
             spheres: Vec::new(),
             count: 0,
             max_radius: None,
+            min_radius: None,
             energy: 0.0,
             energy_reset,
             max_overlap_rel: 0.0,
@@ -119,13 +122,15 @@ impl Snapshot {
         let escaped = AtomicUsize::new(0);
         // Radii are positive, so their bits order like the numbers.
         let widest = AtomicU64::new(0);
+        let narrowest = AtomicU64::new(u64::MAX);
         let tol = 1e-9 * world.size;
         let scan = |b: usize, out: Option<&mut [SphereView]>| {
             let block = &sp[b * VIEW_BLOCK..sp.len().min((b + 1) * VIEW_BLOCK)];
-            let (mut n, mut r) = (0, 0.0f64);
+            let (mut n, mut r, mut least) = (0, 0.0f64, f64::INFINITY);
             for s in block {
                 n += usize::from(escapes(s, world.size, tol));
                 r = r.max(s.radius);
+                least = least.min(s.radius);
             }
             if let Some(out) = out {
                 for (v, s) in out.iter_mut().zip(block) {
@@ -138,6 +143,7 @@ impl Snapshot {
             }
             escaped.fetch_add(n, Ordering::Relaxed);
             widest.fetch_max(r.to_bits(), Ordering::Relaxed);
+            narrowest.fetch_min(least.to_bits(), Ordering::Relaxed);
         };
         if views {
             self.spheres.resize(sp.len(), SphereView::default());
@@ -152,6 +158,7 @@ impl Snapshot {
         }
         self.count = sp.len();
         self.max_radius = (!sp.is_empty()).then(|| f64::from_bits(widest.into_inner()));
+        self.min_radius = (!sp.is_empty()).then(|| f64::from_bits(narrowest.into_inner()));
         self.energy = world.kinetic_energy();
         self.parts = parts;
         self.max_overlap_rel = overlap.deepest_rel;

@@ -6,12 +6,14 @@ use crossterm::event::{KeyCode, KeyEvent, KeyEventKind, KeyModifiers};
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Action {
     Quit,
-    /// Esc: closes the help if it is open, else quits.
+    /// Esc: closes the help if it is open, else the chart, else quits.
     Escape,
     ToggleThreading,
     CycleThreadedMode,
     FewerThreads,
     MoreThreads,
+    /// Flat out (tick `max`) on/off, back to the tick before.
+    FlatOut,
     TickDown,
     TickUp,
     Pause,
@@ -100,6 +102,7 @@ mod tests {
             (KeyCode::Char('F'), Action::FasterFps),
             (KeyCode::Char('c'), Action::Chart),
             (KeyCode::Char('s'), Action::SortThreads),
+            (KeyCode::Char('x'), Action::FlatOut),
         ];
         for (code, want) in table {
             assert_eq!(action(press(code)), Some(want), "{code:?}");
@@ -111,7 +114,7 @@ mod tests {
             KeyModifiers::CONTROL | KeyModifiers::SHIFT,
         );
         assert_eq!(action(ctrl_shift_c), Some(Action::Quit));
-        assert_eq!(action(press(KeyCode::Char('x'))), None);
+        assert_eq!(action(press(KeyCode::Char('y'))), None);
         let ctrl_t = KeyEvent::new(KeyCode::Char('t'), KeyModifiers::CONTROL);
         assert_eq!(action(ctrl_t), None);
         let mut release = press(KeyCode::Char('q'));

@@ -94,7 +94,7 @@ pub const TABLE: &[Binding] = &[
             (K::Esc, A::Escape),
             (K::Ctrl('c'), A::Quit),
         ],
-        help: "quit (Esc first closes this help)",
+        help: "quit (Esc first closes this help, then the chart)",
         bar: Some(("quit", 1)),
     },
     Binding {
@@ -126,8 +126,13 @@ pub const TABLE: &[Binding] = &[
         bar: Some(("sort", 16)),
     },
     Binding {
+        presses: &[(K::Char('x'), A::FlatOut)],
+        help: "flat out on/off: as many steps as each frame allows",
+        bar: Some(("flat", 2)),
+    },
+    Binding {
         presses: &[(K::Char('['), A::TickDown), (K::Char(']'), A::TickUp)],
-        help: "physics tick - / + (0 freezes)",
+        help: "physics tick - / + (0 freezes; up to 1000000, as --tick)",
         bar: Some(("tick", 7)),
     },
     Binding {

@@ -38,6 +38,8 @@ pub struct Options {
     /// Frames per second to aim at (default 30).
     pub fps: f64,
     pub color: ColorChoice,
+    /// `--tick max`: start flat out (key x).
+    pub flat_out: bool,
 }
 
 impl Default for Options {
@@ -45,6 +47,7 @@ impl Default for Options {
         Options {
             fps: 30.0,
             color: ColorChoice::Auto,
+            flat_out: false,
         }
     }
 }

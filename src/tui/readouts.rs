@@ -9,6 +9,7 @@ use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Paragraph, Widget, Wrap};
+use std::time::Duration;
 
 /// Figures the frame loop measures (the rest come from the snapshot).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -30,10 +31,61 @@ pub struct Stats {
     /// The link is slower than the frames: the compact form shows it in
     /// place of the render time, as the reason the picture slowed.
     pub link_slow: bool,
+    /// A threaded frame still computing: its steps so far and its age.
+    pub under_way: Option<(u64, Duration)>,
+    /// Flat out: steps/s measured per mode (`AppState::mode_label`) on the
+    /// scene `flat_scene`, the latest whole second of each.
+    pub flat: Vec<(String, f64)>,
+    pub flat_scene: u64,
+    /// The mode and scene of the last second, to keep only whole seconds
+    /// of one mode.
+    pub flat_last: Option<(String, u64)>,
+}
+
+impl Stats {
+    /// Flat out: how long a frame's physics may step. With the physics on
+    /// `main` (off), the period less the drawing's share (and a margin);
+    /// on a physics thread, most of the period, as the drawing runs beside it.
+    pub fn flat_out_budget(&self, state: &AppState) -> Duration {
+        let period = 1.0 / state.fps;
+        let share = if state.threading == Threading::Off {
+            period - 1.5 * self.render_seconds - 1e-3
+        } else {
+            0.9 * period
+        };
+        Duration::from_secs_f64(share.clamp(0.1 * period, 0.9 * period))
+    }
+
+    /// After a second's figures: keep flat out's steps/s for this mode, if
+    /// the whole second ran flat out in this mode on this scene; a new
+    /// scene starts the comparison again.
+    pub fn remember(&mut self, state: &AppState) {
+        if self.flat_scene != state.scene {
+            self.flat.clear();
+            self.flat_scene = state.scene;
+        }
+        let now = (state.flat_out && state.running()).then(|| (state.mode_label(), state.scene));
+        if let Some(n) = &now
+            && self.flat_last.as_ref() == Some(n)
+            && self.steps_per_second > 0.0
+        {
+            match self.flat.iter_mut().find(|(m, _)| *m == n.0) {
+                Some(e) => e.1 = self.steps_per_second,
+                None => self.flat.push((n.0.clone(), self.steps_per_second)),
+            }
+        }
+        self.flat_last = now;
+    }
+
+    /// Flat out's steps/s in `mode` over those in `off`, when both are known.
+    pub fn speed_up(&self, mode: &str) -> Option<f64> {
+        let get = |m: &str| self.flat.iter().find(|e| e.0 == m).map(|e| e.1);
+        Some(get(mode)? / get("off")?)
+    }
 }
 
 /// Rows of figures in the full form, and of the compact one.
-const FULL_ROWS: u16 = 15;
+const FULL_ROWS: u16 = 16;
 const COMPACT_ROWS: u16 = 7;
 /// Rows kept for a notice, so a long one wraps instead of being cut.
 const NOTICE_ROWS: u16 = 2;
@@ -75,22 +127,96 @@ impl Readouts<'_> {
     /// are only redrawn when something changes.
     fn fps(&self, compact: bool) -> String {
         let s = self.state;
-        match (s.paused, s.tick) {
+        match (s.paused, s.engine_tick()) {
             (true, _) => "paused".into(),
             (false, 0) if compact => "frozen".into(),
             (false, 0) => "frozen (tick 0)".into(),
-            _ if compact => format!("{:.1} of {}", self.stats.fps, s.fps),
-            _ => format!("{:<8.1} target {}", self.stats.fps, s.fps),
+            // A window's count can hold one frame more than its periods:
+            // never show more frames than the target allows.
+            _ if compact => format!("{:.1} of {}", self.stats.fps.min(s.fps), s.fps),
+            _ => format!("{:<8.1} target {}", self.stats.fps.min(s.fps), s.fps),
         }
     }
 
     /// The radius in force: the snapshot's, never the one asked for.
-    fn radius(&self) -> String {
-        representative_radius(self.snap).map_or_else(|| "-".into(), |r| format!("{r:.5}"))
+    /// A mixed scene shows its range, smallest to largest.
+    fn radius(&self, compact: bool) -> String {
+        let Some(max) = representative_radius(self.snap) else {
+            return "-".into();
+        };
+        match self.snap.min_radius {
+            Some(min) if min < max && compact => format!("{min:.3}-{max:.3}"),
+            Some(min) if min < max => format!("{min:.5}-{max:.5}"),
+            _ => format!("{max:.5}"),
+        }
+    }
+
+    /// Simulated seconds per second: steps/s times dt, so `f`/`F` (and
+    /// the tick) explain the speed they change.
+    fn sim_speed(&self) -> String {
+        format!(
+            "sim {:.2} s/s",
+            self.stats.steps_per_second * self.snap.settings.dt
+        )
+    }
+
+    /// A frame that has run longer than a few periods, as "N steps, T s".
+    fn long_frame(&self) -> Option<String> {
+        let (steps, age) = self.stats.under_way?;
+        (age.as_secs_f64() > 3.0 / self.state.fps)
+            .then(|| format!("{steps} steps, {:.1} s", age.as_secs_f64()))
+    }
+
+    /// Steps per second: flat out's with its speed-up over `off`, or a
+    /// long frame's rate so far.
+    fn steps_per_second(&self, compact: bool) -> String {
+        let st = self.stats;
+        if let Some((steps, age)) = st.under_way.filter(|_| self.long_frame().is_some()) {
+            let rate = steps as f64 / age.as_secs_f64().max(1e-9);
+            return format!("{rate:.0} this frame");
+        }
+        let now = if compact {
+            format!("{:.0}/s", st.steps_per_second)
+        } else {
+            format!("{:<8.0}", st.steps_per_second)
+        };
+        if !self.state.flat_out {
+            return now;
+        }
+        match st.speed_up(&self.state.mode_label()) {
+            Some(x) if compact => format!("{now} {x:.2}x"),
+            Some(x) => format!("{now} flat out, {x:.2}x off"),
+            None if compact => now,
+            None => format!("{now} flat out"),
+        }
+    }
+
+    /// Flat out's comparison: every mode measured on this scene, as its
+    /// speed-up over `off` (kept while the user switches modes).
+    fn comparison(&self) -> String {
+        let st = self.stats;
+        if !self.state.flat_out {
+            return "x: flat out compares the modes".into();
+        }
+        let rows: Vec<String> = st
+            .flat
+            .iter()
+            .filter(|(m, _)| m != "off")
+            .filter_map(|(m, _)| st.speed_up(m).map(|x| format!("{m} {x:.2}x")))
+            .collect();
+        if st.speed_up("off").is_none() {
+            "measure off first (t)".into()
+        } else if rows.is_empty() {
+            "t, d: measure the other modes".into()
+        } else {
+            rows.join(" ")
+        }
     }
 
     fn physics_ms(&self) -> String {
-        if self.state.running() {
+        if let Some(long) = self.long_frame() {
+            long
+        } else if self.state.running() {
             format!("{:.2} ms", self.stats.physics_seconds * 1e3)
         } else {
             "idle".into()
@@ -123,14 +249,23 @@ impl Readouts<'_> {
             s.tick,
             if s.tick == 1 { "" } else { "s" }
         );
-        if s.tick == 0 {
+        if s.flat_out {
+            tick = format!("{:<8} flat out (x: tick {})", "max", s.tick);
+        } else if s.tick == 0 {
             tick.push_str("  frozen");
+        } else {
+            tick = format!(
+                "{} step{}/frame  {}",
+                s.tick,
+                if s.tick == 1 { "" } else { "s" },
+                self.sim_speed()
+            );
         }
         vec![
             row("threading", self.threading()),
             row("tick", tick),
             row("count", format!("{}", snap.count)),
-            row("radius", self.radius()),
+            row("radius", self.radius(false)),
             row(
                 "model",
                 model_row(s.model, snap.parts, snap.choice.as_ref()),
@@ -140,7 +275,9 @@ impl Readouts<'_> {
             row("fps", self.fps(false)),
             row(
                 "physics",
-                if s.running() {
+                if self.long_frame().is_some() {
+                    format!("under way, {}", self.physics_ms())
+                } else if s.running() {
                     format!("{:<8} per frame", self.physics_ms())
                 } else {
                     self.physics_ms()
@@ -153,10 +290,11 @@ impl Readouts<'_> {
                     format!("{:.2} ms", st.render_seconds * 1e3)
                 ),
             ),
-            row("steps/s", format!("{:<8.0}", st.steps_per_second)),
+            row("steps/s", self.steps_per_second(false)),
+            row("vs off", self.comparison()),
             row(
                 "drift",
-                format!("{:<8.1e} energy since reset", snap.energy_drift()),
+                format!("{:<8.1e} energy vs start/edit", snap.energy_drift()),
             ),
             row(
                 "overlap",
@@ -208,11 +346,15 @@ impl Readouts<'_> {
                 "tick",
                 // The number first and alone, as in the full form, so a
                 // reader (or a test) takes the tick from the first word.
-                format!("{} step{}", s.tick, if s.tick == 1 { "" } else { "s" }),
+                if s.flat_out {
+                    "max".into()
+                } else {
+                    format!("{} step{}", s.tick, if s.tick == 1 { "" } else { "s" })
+                },
                 "count",
                 snap.count.to_string(),
             ),
-            pair("radius", self.radius(), "model", model),
+            pair("radius", self.radius(true), "model", model),
             pair("fps", self.fps(true), "physics", self.physics_ms()),
             match (&st.link, st.link_slow) {
                 (Some(link), true) => Line::from(vec![
@@ -234,7 +376,7 @@ impl Readouts<'_> {
             ),
             pair(
                 "steps",
-                format!("{:.0}/s", st.steps_per_second),
+                self.steps_per_second(true),
                 "coll",
                 format!("{:.0}/s", st.collisions_per_second),
             ),

@@ -79,12 +79,13 @@ pub fn run_with(
     // crossterm drops colours itself under NO_COLOR; the resolved palette
     // already says whether there are any (a --color flag overrides NO_COLOR).
     crossterm::style::Colored::set_ansi_color_disabled(!palette.has_color());
-    let state = AppState::new(
+    let mut state = AppState::new(
         &settings,
         world.spheres.len(),
         world.spheres.iter().map(|s| s.radius).fold(0.0, f64::max),
         opts.fps,
     );
+    state.flat_out = opts.flat_out;
     let engine = match rebuild {
         Some(r) => Engine::with_rebuild(world, settings, r)?,
         None => Engine::new(world, settings)?,
@@ -245,6 +246,9 @@ impl FrameLoop {
     fn run(mut self, rx: &Receiver<Msg>) -> anyhow::Result<()> {
         let mut next_frame = Instant::now();
         let mut next_sample = Instant::now() + SAMPLE_PERIOD;
+        // The scene at once, before a first frame's physics (a long tick in
+        // `off` runs on this thread).
+        self.draw(false)?;
         loop {
             let wants_frame = !self.held
                 && (self.state.running() || self.pending || self.dirty || self.in_flight.is_some());
@@ -378,7 +382,7 @@ impl FrameLoop {
         }
         if self.state.running() || self.pending {
             let tick = if self.state.running() {
-                self.state.tick
+                self.state.engine_tick()
             } else {
                 0
             };
@@ -386,6 +390,13 @@ impl FrameLoop {
                 self.engine.command(Command::SetTick(tick));
                 self.sent_tick = tick;
             }
+            if self.pending {
+                // The key's answer first: applying it may take long (N).
+                self.present()?;
+            }
+            let budget = self.state.flat_out;
+            self.engine
+                .set_budget(budget.then(|| self.stats.flat_out_budget(&self.state)));
             self.engine.start_frame()?;
             self.in_flight = Some(self.pending);
             self.pending = false;
@@ -410,6 +421,7 @@ impl FrameLoop {
     /// of the last frame when the link is slow.
     fn draw(&mut self, update: bool) -> anyhow::Result<()> {
         let t0 = Instant::now();
+        self.stats.under_way = self.engine.under_way();
         let before = self.bytes.load(Ordering::Relaxed);
         let slow = self.pacer.slow();
         let keep_canvas = update && slow && self.drawn.is_some();
@@ -509,6 +521,7 @@ impl FrameLoop {
         let st = &mut self.stats;
         st.fps = f64::from(w.frames) / secs;
         st.steps_per_second = w.steps as f64 / secs;
+        st.remember(&self.state);
         st.collisions_per_second = total.saturating_sub(w.collisions_at_start) as f64 / secs;
         if w.frames > 0 {
             st.render_seconds = w.render_seconds / f64::from(w.frames);

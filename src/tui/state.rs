@@ -6,9 +6,12 @@ use super::projection::Camera;
 use crate::engine::{Command, MAX_THREADS, Settings, Snapshot, Threading};
 use crate::physics::ModelKind;
 
-pub const MAX_TICK: u32 = 1000;
+/// The most steps a frame runs, for `--tick` and the keys alike.
+pub const MAX_TICK: u32 = 1_000_000;
 pub const MAX_COUNT: usize = 1 << 21;
 pub const MIN_RADIUS: f64 = 1e-4;
+/// A count from which placing the spheres takes long enough to say so.
+pub const BIG_EDIT: usize = 100_000;
 pub const RADIUS_STEP: f64 = 1.25;
 pub const CAMERA_STEP: f64 = std::f64::consts::PI / 18.0;
 pub const MAX_PITCH: f64 = 1.5;
@@ -22,6 +25,12 @@ pub struct AppState {
     pub last_threaded: Threading,
     pub threads: usize,
     pub tick: u32,
+    /// Flat out (`--tick max`, key x): each frame runs as many steps as its
+    /// time allows; `tick` is kept to go back to.
+    pub flat_out: bool,
+    /// Counts the changes of scene (count, radius, model, reset), so
+    /// figures measured on one scene are not compared with another's.
+    pub scene: u64,
     pub paused: bool,
     pub model: ModelKind,
     pub count: usize,
@@ -38,6 +47,9 @@ pub struct AppState {
     pub quit: bool,
     /// A limit a key ran into, shown until the next key.
     pub notice: Option<String>,
+    /// The notice says work is under way (placing spheres): the frame that
+    /// does it ends it.
+    pub under_way: bool,
 }
 
 impl AppState {
@@ -51,6 +63,8 @@ impl AppState {
             },
             threads: settings.threads.max(1),
             tick: settings.tick,
+            flat_out: false,
+            scene: 0,
             paused: false,
             model: settings.model,
             count,
@@ -64,24 +78,38 @@ impl AppState {
             fps,
             quit: false,
             notice: None,
+            under_way: false,
         }
     }
 
     /// Whether frames should step the physics.
     pub fn running(&self) -> bool {
-        !self.paused && self.tick > 0
+        !self.paused && (self.flat_out || self.tick > 0)
+    }
+
+    /// The tick the engine runs with: flat out needs a tick above 0 (the
+    /// frame's time budget, not the tick, says how many steps).
+    pub fn engine_tick(&self) -> u32 {
+        if self.flat_out {
+            self.tick.max(1)
+        } else {
+            self.tick
+        }
     }
 
     /// Do one key; returns what the engine must be told.
     #[allow(clippy::too_many_lines)] // one arm a key, as the key table lists them
     pub fn apply(&mut self, action: Action) -> Vec<Command> {
         self.notice = None;
+        self.under_way = false;
         let mut out = Vec::new();
         match action {
             Action::Quit => self.quit = true,
             Action::Escape => {
                 if self.help {
                     self.help = false;
+                } else if self.chart {
+                    self.chart = false;
                 } else {
                     self.quit = true;
                 }
@@ -134,6 +162,24 @@ impl AppState {
                     }
                 }
             }
+            Action::FlatOut => {
+                self.flat_out = !self.flat_out;
+                self.notice = Some(if self.flat_out {
+                    format!(
+                        "flat out: as many steps as each frame allows (x: back to tick {})",
+                        self.tick
+                    )
+                } else {
+                    format!("flat out off: tick {}", self.tick)
+                });
+                self.tell_if_paused();
+            }
+            Action::TickDown | Action::TickUp if self.flat_out => {
+                self.notice = Some(format!(
+                    "flat out sets the steps; x goes back to tick {}",
+                    self.tick
+                ));
+            }
             Action::TickDown => {
                 if self.tick == 0 {
                     self.notice = Some("tick 0: physics frozen".into());
@@ -165,6 +211,10 @@ impl AppState {
                 } else {
                     self.count = (self.count * 2).max(1);
                     out.push(Command::SetCount(self.count));
+                    if self.count >= BIG_EDIT {
+                        self.notice = Some(format!("placing {} spheres...", self.count));
+                        self.under_way = true;
+                    }
                 }
             }
             Action::Smaller => {
@@ -197,7 +247,10 @@ impl AppState {
             }
             Action::Chart => self.chart = !self.chart,
             Action::SortThreads => self.threads_by_cpu = !self.threads_by_cpu,
-            Action::Reset => out.push(Command::Reset),
+            Action::Reset => {
+                out.push(Command::Reset);
+                self.notice = Some("scene back to its start".into());
+            }
             Action::Help => self.help = !self.help,
             Action::Suspend => {} // the input thread stops the process
             Action::SlowerFps => match FPS_STEPS.iter().rev().find(|&&f| f < self.fps - 1e-9) {
@@ -210,6 +263,19 @@ impl AppState {
                     self.notice = Some(format!("fps limit: {}", FPS_STEPS[FPS_STEPS.len() - 1]));
                 }
             },
+        }
+        if !out.is_empty()
+            && matches!(
+                action,
+                Action::HalveCount
+                    | Action::DoubleCount
+                    | Action::Smaller
+                    | Action::Bigger
+                    | Action::CycleModel
+                    | Action::Reset
+            )
+        {
+            self.scene += 1;
         }
         if self.chart
             && matches!(
@@ -227,9 +293,19 @@ impl AppState {
         out
     }
 
+    /// The mode as flat out's comparison names it (a pool with its size).
+    pub fn mode_label(&self) -> String {
+        match self.threading {
+            Threading::Pool => format!("pool {}", self.threads),
+            t => t.name().to_string(),
+        }
+    }
+
     /// The tick is kept while paused; it runs on resume.
     fn tell_if_paused(&mut self) {
-        if self.paused {
+        if self.paused && self.flat_out {
+            self.notice = Some("flat out: runs when resumed (space)".into());
+        } else if self.paused {
             self.notice = Some(format!("tick {}: runs when resumed (space)", self.tick));
         }
     }
@@ -242,8 +318,15 @@ impl AppState {
         if let Some(r) = representative_radius(snap) {
             self.radius = r;
         }
+        // The engine's notice (a limit it hit) answers the commands; with
+        // none, the key's own notice stays, unless it said work was under way.
         if applied {
-            self.notice.clone_from(&snap.notice);
+            if snap.notice.is_some() {
+                self.notice.clone_from(&snap.notice);
+            } else if self.under_way {
+                self.notice = None;
+            }
+            self.under_way = false;
         }
     }
 }
