@@ -352,6 +352,10 @@ fn the_model_row_says_what_auto_runs() {
         detected: Some(Palette::True),
         link: None,
         link_slow: false,
+        under_way: None,
+        flat: Vec::new(),
+        flat_scene: 0,
+        flat_last: None,
     };
     let mut t = ratatui::Terminal::new(ratatui::backend::TestBackend::new(
         72,

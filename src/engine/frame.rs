@@ -2,7 +2,7 @@
 //! world, the model, the executor, and the back snapshot to fill.
 use super::Settings;
 use super::snapshot::{Overlap, OverlapScratch, Snapshot};
-use crate::physics::{Exec, Model, ModelKind, World};
+use crate::physics::{Exec, Model, World};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -106,10 +106,10 @@ impl Frame {
         let dt = self.settings.dt;
         let tick = u64::from(self.settings.tick);
         let budget = self.budget.filter(|_| tick > 0);
-        // `exact` gives other bits when its steps are cut differently, so
-        // it steps one at a time flat out (a state then depends on the
-        // step count alone) and runs a tick in one piece, as it always did.
-        let cuts_freely = self.settings.model != ModelKind::Exact;
+        // `exact` and `auto` give other bits when their steps are cut
+        // differently, so they step one at a time flat out (a state then
+        // depends on the step count alone) and run a tick in one piece.
+        let cuts_freely = self.settings.model.cuts_freely();
         let (mut done, mut chunk) = (0_u64, if cuts_freely { 1 } else { tick });
         self.progress.store(0, Ordering::Relaxed);
         loop {

@@ -39,6 +39,14 @@ impl ModelKind {
         matches!(self, ModelKind::Exact)
     }
 
+    /// Whether a run of steps gives the same bits however it is cut into
+    /// `advance` calls: not for `exact` (its schedule is rebuilt at each
+    /// call's end), nor for `auto` (it may run `exact`, and it chooses
+    /// again when the steps per call change).
+    pub fn cuts_freely(self) -> bool {
+        matches!(self, ModelKind::Discrete | ModelKind::Swept)
+    }
+
     /// The next model in the `m` key's cycle.
     #[must_use]
     pub fn next(self) -> ModelKind {
