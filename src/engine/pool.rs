@@ -17,8 +17,8 @@ pub struct PoolExec {
     /// its index).
     busy: AtomicUsize,
     bound: AtomicUsize,
-    /// Nanoseconds spent inside sections of more than one lane, for the
-    /// serial fraction (`ballpit scaling`): two clock reads a section.
+    /// Nanoseconds spent inside sections of more than one lane, for a
+    /// step's serial fraction: two clock reads a section.
     parallel_ns: AtomicU64,
 }
 
