@@ -48,13 +48,13 @@ fn flat_out(model: ModelKind, threading: Threading, frames: usize) -> (World, u6
 /// flat out steps one at a time: frames of one step.
 fn ticked(model: ModelKind, steps: u64) -> World {
     let mut e = Engine::new(world(), settings(model, Threading::Off, 1)).unwrap();
-    let frames = if !model.cuts_freely() {
-        steps
-    } else {
+    let frames = if model.cuts_freely() {
         e.command(ballpit::engine::Command::SetTick(
             u32::try_from(steps).unwrap(),
         ));
         1
+    } else {
+        steps
     };
     for _ in 0..frames {
         e.start_frame().unwrap();
