@@ -96,13 +96,7 @@ fn a_fifo_that_never_closes_is_refused() {
     let d = dir("fifo_open");
     for ext in ["csv", "toml"] {
         let fifo = d.join(format!("fifo.{ext}"));
-        assert!(
-            Command::new("mkfifo")
-                .arg(&fifo)
-                .status()
-                .unwrap()
-                .success()
-        );
+        mkfifo(&fifo);
         // A writer that holds the FIFO open and sends a line, then nothing.
         let mut writer = Command::new("sh")
             .arg("-c")
@@ -122,13 +116,7 @@ fn a_fifo_that_never_closes_is_refused() {
 fn a_fifo_that_ends_is_read() {
     let d = dir("fifo_ends");
     let fifo = d.join("ends.csv");
-    assert!(
-        Command::new("mkfifo")
-            .arg(&fifo)
-            .status()
-            .unwrap()
-            .success()
-    );
+    mkfifo(&fifo);
     let mut writer = Command::new("sh")
         .arg("-c")
         .arg("printf 'x,y,z,vx,vy,vz,radius,mass\\n0.5,0.5,0.5,0,0,0,0.1,1\\n' > \"$1\"")
@@ -146,13 +134,7 @@ fn a_fifo_that_ends_is_read() {
 fn an_endless_stream_of_valid_rows_stops_at_the_largest_scene() {
     let d = dir("rows");
     let fifo = d.join("rows.csv");
-    assert!(
-        Command::new("mkfifo")
-            .arg(&fifo)
-            .status()
-            .unwrap()
-            .success()
-    );
+    mkfifo(&fifo);
     let mut writer = Command::new("sh")
         .arg("-c")
         .arg("exec yes 0,0,0,0,0,0,0,0 > \"$1\"")
@@ -203,4 +185,10 @@ fn a_scene_on_stdin_is_read_within_the_same_bound() {
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("is not text"), "{err}");
     let _ = std::fs::remove_dir_all(&d);
+}
+
+/// A named pipe at `path`.
+fn mkfifo(path: &std::path::Path) {
+    let made = Command::new("mkfifo").arg(path).status().unwrap();
+    assert!(made.success(), "mkfifo {}", path.display());
 }
