@@ -6,19 +6,12 @@ use ballpit::engine::{Command, Engine, Settings, Threading};
 use ballpit::physics::auto::{Ask, Summary, Tolerance, choose};
 use ballpit::physics::swept::parts;
 use ballpit::physics::{ModelKind, Serial, Sphere, World};
+use ballpit::scene::presets::PRESETS;
 use ballpit::scene::{SceneSpec, build_world};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 
-const PRESETS: [&str; 6] = [
-    "gas",
-    "billiards",
-    "dense",
-    "projectiles",
-    "cradle",
-    "mixed",
-];
 const DTS: [f64; 3] = [1.0 / 15.0, 1.0 / 60.0, 1.0 / 1920.0];
 
 fn preset(name: &str) -> World {
@@ -213,7 +206,7 @@ fn settings(model: ModelKind, threading: Threading, dt: f64) -> Settings {
 /// on every preset.
 #[test]
 fn auto_is_bit_identical_across_threading_modes_on_every_preset() {
-    for name in PRESETS {
+    for name in PRESETS.map(|p| p.name) {
         let start = preset(name);
         let mut first: Option<(World, ModelKind)> = None;
         for mode in Threading::ALL {
