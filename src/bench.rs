@@ -38,6 +38,10 @@ pub struct BenchReport {
     /// sleep between frames, up to the last scheduler tick for the caller
     /// in `off`.
     pub physics_cpu_seconds: f64,
+    /// In `pool`: the part of `wall_seconds` spent inside sections that ran
+    /// on more than one lane; the rest is the step's serial part (null in
+    /// the other modes).
+    pub parallel_seconds: Option<f64>,
     /// The 1-minute load average of the host (`/proc/loadavg`) before and
     /// after stepping, so a reader can judge the timings; empty elsewhere.
     pub load_average: Vec<f64>,
@@ -141,7 +145,10 @@ pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(Ben
     {
         cpu_before.push((tid, crate::cpu::thread_cpu_seconds_of(tid).unwrap_or(0.0)));
     }
+    let parallel_before = engine.parallel_seconds().unwrap_or(0.0);
     let (wall, max_err) = step_frames(&mut engine, steps, frame, &rel)?;
+    let parallel_seconds = (settings.threading == crate::engine::Threading::Pool)
+        .then(|| engine.parallel_seconds().unwrap_or(0.0) - parallel_before);
     let physics_threads = engine.physics_threads();
     let physics_cpu_seconds = physics_cpu(&engine, &physics_threads, &cpu_before);
     let load_end = load_average();
@@ -176,6 +183,7 @@ pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(Ben
         physics_threads,
         wall_seconds: wall,
         physics_cpu_seconds,
+        parallel_seconds,
         load_average: load_start.into_iter().chain(load_end).collect(),
         steps_per_second: per_sec(steps as f64),
         sphere_steps_per_second: per_sec(steps as f64 * n as f64),
@@ -253,7 +261,7 @@ fn physics_cpu(engine: &Engine, names: &[String], before: &[(i32, f64)]) -> f64 
 }
 
 /// The 1-minute load average (Linux), `None` elsewhere.
-fn load_average() -> Option<f64> {
+pub fn load_average() -> Option<f64> {
     std::fs::read_to_string("/proc/loadavg")
         .ok()?
         .split_whitespace()

@@ -6,6 +6,8 @@ pub mod engine;
 pub mod error;
 pub mod memory;
 pub mod physics;
+pub mod progress;
+pub mod scaling;
 pub mod scene;
 pub mod tradeoff;
 pub mod tui;

@@ -50,6 +50,18 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let table = ballpit::tradeoff::run(&world, args.out.as_deref())?;
             Ok(emit(table.as_bytes())?)
         }
+        Some(Command::Scaling(args)) => {
+            if !(args.dt.is_finite() && args.dt > 0.0) {
+                return Err(
+                    BadInput(format!("--dt must be a finite number > 0, got {}", args.dt)).into(),
+                );
+            }
+            let plan = args.plan();
+            let world = scene::build_world_for(&args.spec(), Some(plan.model))?;
+            fits(world.spheres.len(), Some(plan.model))?;
+            let table = ballpit::scaling::run(&world, &plan, args.out.as_deref())?;
+            Ok(emit(table.as_bytes())?)
+        }
         Some(Command::Completions { shell }) => {
             let mut script = Vec::new();
             clap_complete::generate(shell, &mut Cli::command(), "ballpit", &mut script);

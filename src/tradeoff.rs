@@ -18,10 +18,8 @@
 //! collisions per sphere any two runs differ by the box.
 use crate::physics::{ModelKind, Serial, World, reference};
 use anyhow::Context;
-use indicatif::{ProgressBar, ProgressStyle};
 use plotters::prelude::*;
 use std::fmt::Write as _;
-use std::io::IsTerminal;
 use std::path::Path;
 use std::time::Instant;
 
@@ -177,7 +175,7 @@ fn position_error(world: &World, kind: ModelKind, dt: f64, steps: u64, truth: &W
     (sum / a.spheres.len() as f64).sqrt() / world.size
 }
 
-fn dt_label(dt: f64) -> String {
+pub(crate) fn dt_label(dt: f64) -> String {
     format!("1/{}", (1.0 / dt).round())
 }
 
@@ -327,32 +325,9 @@ pub fn run(world: &World, out: Option<&Path>) -> anyhow::Result<String> {
             crate::error::BadInput(format!("cannot create directory {}: {e}", dir.display()))
         })?;
     }
-    let bar = progress_bar();
-    // The reference run alone takes seconds to minutes: a named thread ticks
-    // the bar (spinner and clock) four times a second until it is finished.
-    let ticker = (!bar.is_hidden())
-        .then(|| {
-            let bar = bar.clone();
-            std::thread::Builder::new()
-                .name("progress".into())
-                .spawn(move || {
-                    while !bar.is_finished() {
-                        bar.tick();
-                        std::thread::park_timeout(std::time::Duration::from_millis(250));
-                    }
-                })
-                .ok()
-        })
-        .flatten();
-    let rows = measure_with(world, &mut |done, next| {
-        bar.set_position(done as u64);
-        bar.set_message(next.to_string());
-    });
-    bar.finish_and_clear();
-    if let Some(t) = ticker {
-        t.thread().unpark();
-        let _ = t.join();
-    }
+    let bar = crate::progress::Progress::new(RUNS);
+    let rows = measure_with(world, &mut |done, next| bar.set(done, next));
+    bar.finish();
     if let Some(dir) = out {
         let csv_path = dir.join("tradeoff.csv");
         std::fs::write(&csv_path, csv(&rows)?)
@@ -360,22 +335,6 @@ pub fn run(world: &World, out: Option<&Path>) -> anyhow::Result<String> {
         svg(&rows, &dir.join("tradeoff.svg"))?;
     }
     Ok(markdown(&rows))
-}
-
-/// Runs done, on stderr when it is a terminal; hidden in pipes and tests,
-/// where it would only add noise to what is read.
-fn progress_bar() -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(RUNS as u64);
-    // The template is a constant: it either parses or fails here alike.
-    if let Ok(style) =
-        ProgressStyle::with_template("{spinner} {bar:20} {pos}/{len} runs, {elapsed}: {msg}")
-    {
-        bar.set_style(style);
-    }
-    bar
 }
 
 #[cfg(test)]

@@ -221,6 +221,11 @@ fn every_command_the_readme_shows_parses_and_validates() {
                     dumped.extend(b.dump.iter().cloned());
                 }
                 Some(Command::Tradeoff(t)) => check_scene(&t.scene, &dumped, line),
+                Some(Command::Scaling(s)) => {
+                    if let Err(e) = scene::build_world(&s.spec()) {
+                        panic!("`{line}`: {e}");
+                    }
+                }
                 Some(Command::Completions { .. } | Command::Man) => {}
             }
             parsed += 1;

@@ -35,6 +35,10 @@ pub const BENCH_FIELDS: &[(&str, &str)] = &[
         "CPU time of the physics_threads while stepping",
     ),
     (
+        "parallel_seconds",
+        "pool only: the part of wall_seconds in sections on more than one lane (null otherwise)",
+    ),
+    (
         "load_average",
         "[start, end] 1-minute load average of the host (/proc/loadavg)",
     ),
@@ -103,6 +107,18 @@ pub(super) fn tradeoff_after_help() -> String {
         "With --out DIR it also writes DIR/tradeoff.csv (columns: {}) and DIR/tradeoff.svg \
          (position error against cost, one line per model).",
         CSV_COLUMNS.join(", ")
+    )
+}
+
+pub(super) fn scaling_after_help() -> String {
+    format!(
+        "Without --scene: {} spheres of the gas at packing {} (--count N keeps the packing \
+         unless --radius is given). With --out DIR it also writes DIR/scaling.csv (columns: {}) \
+         and DIR/scaling.svg (speed-up against threads, with the fit's prediction).\n\n\
+         Example: ballpit scaling --out /tmp/scaling",
+        super::SCALING_COUNT,
+        super::SCALING_PACKING,
+        crate::scaling::CSV_COLUMNS.join(", ")
     )
 }
 

@@ -18,7 +18,9 @@ use crate::scene::SceneSpec;
 use clap::builder::RangedU64ValueParser;
 use clap::parser::ValueSource;
 use clap::{ArgMatches, Args, CommandFactory, FromArgMatches, Parser, Subcommand};
-use help::{bench_after_help, scene_long_help, threads_help, tradeoff_after_help};
+use help::{
+    bench_after_help, scaling_after_help, scene_long_help, threads_help, tradeoff_after_help,
+};
 use std::ffi::OsString;
 use std::path::PathBuf;
 use values::{parse_fps, parse_seconds};
@@ -68,6 +70,21 @@ pub enum Command {
         after_help = tradeoff_after_help()
     )]
     Tradeoff(TradeoffArgs),
+    /// Measure what threading buys here: every mode, pools of 1, 2, 4, … threads
+    #[command(
+        allow_negative_numbers = true,
+        long_about = "Measure what threading buys on this machine, for one scene.\n\n\
+                      Runs off, worker, split, and pool at 1, 2, 4, ... threads up to the core \
+                      count and once at twice it (oversubscribed), every configuration once a \
+                      round, the rounds in alternation, each run the same number of steps. \
+                      Prints a markdown table: steps/s, speed-up over off, efficiency, physics \
+                      CPU seconds, and the pool's serial fraction, measured from its own clock \
+                      and as the Karp-Flatt fraction of its speed-up; then one Amdahl fit of \
+                      the pool's speed-ups and the speed-up it predicts at 16, 64 and 128 cores, \
+                      labelled as a prediction.",
+        after_help = scaling_after_help()
+    )]
+    Scaling(ScalingArgs),
     /// Print a shell completion script, e.g. ballpit completions bash
     Completions {
         /// The shell to complete for
@@ -99,6 +116,71 @@ pub struct TradeoffArgs {
     /// Write tradeoff.csv and tradeoff.svg into this directory
     #[arg(long, value_name = "DIR", value_hint = clap::ValueHint::DirPath)]
     pub out: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct ScalingArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Step length in seconds (> 0), a number or a fraction such as 1/120
+    #[arg(long, default_value = "1/60", value_name = "DT", value_parser = parse_seconds)]
+    pub dt: f64,
+    /// Collision model
+    #[arg(long, value_enum, default_value_t = ModelArg::Swept, value_name = "MODEL")]
+    pub model: ModelArg,
+    /// The largest pool before the oversubscribed one (which is twice it, at most 256)
+    /// [default: available cores]
+    #[arg(long, value_name = "K",
+          value_parser = RangedU64ValueParser::<usize>::new().range(1..=MAX_THREADS as u64))]
+    pub threads: Option<usize>,
+    /// Rounds: every configuration runs once a round (1 to 100)
+    #[arg(long, default_value_t = 3, value_name = "R",
+          value_parser = RangedU64ValueParser::<usize>::new().range(1..=100))]
+    pub rounds: usize,
+    /// Wall seconds an `off` run should take; every run then steps as many steps
+    /// (0 < S <= 600)
+    #[arg(long, default_value = "1", value_name = "S", value_parser = values::parse_run_seconds)]
+    pub seconds: f64,
+    /// Write scaling.csv and scaling.svg into this directory
+    #[arg(long, value_name = "DIR", value_hint = clap::ValueHint::DirPath)]
+    pub out: Option<PathBuf>,
+}
+
+/// `scaling` without `--scene`, `--count` or `--radius`: enough spheres
+/// that a pool has work to share (the screen's default has too few).
+pub const SCALING_COUNT: usize = 100_000;
+/// Packing of `scaling`'s default scene (and of `--count N` without
+/// `--radius` or `--scene`).
+pub const SCALING_PACKING: f64 = 0.05;
+
+impl ScalingArgs {
+    /// The scene: the flags as given, but without `--scene` the gas at
+    /// [`SCALING_COUNT`] spheres (or `--count`) and packing [`SCALING_PACKING`]
+    /// (unless `--radius`).
+    pub fn spec(&self) -> SceneSpec {
+        let mut spec = self.scene.spec();
+        if spec.scene.is_none() {
+            let n = *spec.count.get_or_insert(SCALING_COUNT);
+            if spec.radius.is_none() && n > 0 {
+                let size = spec.size.unwrap_or(1.0);
+                let volume = SCALING_PACKING * size.powi(3) / n as f64;
+                spec.radius = Some((volume * 3.0 / (4.0 * std::f64::consts::PI)).cbrt());
+            }
+        }
+        spec
+    }
+
+    pub fn plan(&self) -> crate::scaling::Plan {
+        let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
+        crate::scaling::Plan {
+            model: self.model.into(),
+            dt: self.dt,
+            top: self.threads.unwrap_or_else(default_threads),
+            rounds: self.rounds,
+            seconds: self.seconds,
+            cores,
+        }
+    }
 }
 
 #[derive(Debug, Args, Clone, Default)]

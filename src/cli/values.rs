@@ -124,6 +124,14 @@ pub(super) fn parse_seconds(s: &str) -> Result<f64, String> {
     v.map_err(|_| "expected seconds as a number or a fraction, e.g. 0.01 or 1/60".to_string())
 }
 
+/// `scaling --seconds`: how long an `off` run should take.
+pub(super) fn parse_run_seconds(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v > 0.0 && v <= 600.0 => Ok(v),
+        _ => Err("expected wall seconds above 0 and at most 600, e.g. 0.5".into()),
+    }
+}
+
 pub(super) fn parse_fps(s: &str) -> Result<f64, String> {
     let fps: f64 = s
         .parse()

@@ -380,6 +380,13 @@ impl Engine {
             .collect()
     }
 
+    /// Seconds the pool has spent so far inside sections of more than one
+    /// lane (`None` before a pool was first used): the rest of a pool
+    /// frame's physics time is its serial part.
+    pub fn parallel_seconds(&self) -> Option<f64> {
+        self.pool.as_ref().map(|p| p.parallel_seconds())
+    }
+
     /// The threads the current settings put physics work on, driver first
     /// (see [`physics_threads`]).
     pub fn physics_threads(&self) -> Vec<String> {
