@@ -20,7 +20,7 @@ mod snapshot;
 mod start;
 mod worker;
 
-pub use pool::{PoolExec, SPLIT_NAMES, SplitExec};
+pub use pool::{PoolExec, Refused, SPLIT_NAMES, SplitExec};
 pub use snapshot::{Snapshot, SphereView};
 pub use start::Rebuild;
 
@@ -166,6 +166,9 @@ pub struct Engine {
     /// The frame's step counter, and when the frame in flight started.
     progress: Arc<AtomicU64>,
     started: Instant,
+    /// A frame has started: threads refused from now on are a notice, not
+    /// the end of the run.
+    running: bool,
 }
 
 impl Engine {
@@ -241,6 +244,7 @@ impl Engine {
             budget: None,
             progress,
             started: Instant::now(),
+            running: false,
         })
     }
 
@@ -281,6 +285,7 @@ impl Engine {
             return Err(e);
         }
         frame.budget = self.budget;
+        self.running = true;
         if self.settings.threading == Threading::Off {
             let frame = worker::run_caught(frame).map_err(|e| self.fail(e))?;
             self.land(frame);
@@ -462,9 +467,33 @@ impl Engine {
                 }
             }
         }
+        frame.exec = match self.exec() {
+            Ok(exec) => exec,
+            Err(refused) if self.running => {
+                let kept = self.keep_going();
+                frame.notice = Some(format!(
+                    "cannot start {}: the system refused a thread ({}); {kept}",
+                    refused.what, refused.cause
+                ));
+                self.exec()
+                    .map_err(|e| crate::error::BadInput(e.to_string()))?
+            }
+            Err(refused) => return Err(crate::error::BadInput(refused.to_string()).into()),
+        };
         frame.settings = self.settings;
-        frame.exec = self.exec()?;
         Ok(())
+    }
+
+    /// Threads were refused while running: go back to what exists (the pool
+    /// there is, else `worker`) and say which.
+    fn keep_going(&mut self) -> String {
+        if let (Some(p), Threading::Pool) = (&self.pool, self.settings.threading) {
+            self.settings.threads = p.threads();
+            format!("kept the {} pool threads there are", p.threads())
+        } else {
+            self.settings.threading = Threading::Worker;
+            "running on worker".into()
+        }
     }
 
     /// The spheres changed from outside the model.
@@ -478,7 +507,7 @@ impl Engine {
     /// The executor for the current mode; pools are made when first needed
     /// and kept (asleep) while other modes run.
     #[allow(clippy::single_match_else)] // the same shape as the pool arm
-    fn exec(&mut self) -> anyhow::Result<SharedExec> {
+    fn exec(&mut self) -> Result<SharedExec, Refused> {
         Ok(match self.settings.threading {
             Threading::Off | Threading::Worker => self.serial.clone(),
             Threading::Pool => {

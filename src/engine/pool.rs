@@ -23,7 +23,9 @@ pub struct PoolExec {
 }
 
 impl PoolExec {
-    pub fn new(threads: usize) -> anyhow::Result<PoolExec> {
+    /// # Errors
+    /// When the system refuses a thread (`ulimit -u`, `ulimit -v`).
+    pub fn new(threads: usize) -> Result<PoolExec, Refused> {
         let threads = threads.max(1);
         // The build error's text is its cause's, and its source that cause
         // again: say it once, as bad input (exit 2), naming what failed.
@@ -31,7 +33,7 @@ impl PoolExec {
             .num_threads(threads)
             .thread_name(|i| format!("pool-{i}"))
             .build()
-            .map_err(|e| refused(&format!("{threads} pool threads"), &e))?;
+            .map_err(|e| Refused::new(format!("{threads} pool threads"), &e))?;
         let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
         Ok(PoolExec {
             pool,
@@ -58,13 +60,37 @@ impl PoolExec {
     }
 }
 
-/// The system would not start a thread (`ulimit -u`, `ulimit -v`).
-fn refused(what: &str, e: &rayon::ThreadPoolBuildError) -> anyhow::Error {
-    crate::error::BadInput(format!(
-        "cannot start {what}: the system refused a thread ({e}); try fewer --threads or raise ulimit -u / ulimit -v"
-    ))
-    .into()
+/// The system would not start a thread (`ulimit -u`, `ulimit -v`). Its
+/// text is the start-up message; running, the engine keeps the threads it
+/// has and says so in a notice.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Refused {
+    /// What could not start, e.g. `64 pool threads`.
+    pub what: String,
+    /// The system's reason, once (rayon's error repeats its cause).
+    pub cause: String,
 }
+
+impl Refused {
+    fn new(what: String, e: &rayon::ThreadPoolBuildError) -> Refused {
+        Refused {
+            what,
+            cause: e.to_string(),
+        }
+    }
+}
+
+impl std::fmt::Display for Refused {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "cannot start {}: the system refused a thread ({}); try fewer --threads or raise ulimit -u / ulimit -v",
+            self.what, self.cause
+        )
+    }
+}
+
+impl std::error::Error for Refused {}
 
 fn thread_ids(pool: &rayon::ThreadPool) -> Vec<(String, i32)> {
     pool.broadcast(|_| {
@@ -152,12 +178,14 @@ pub struct SplitExec {
 }
 
 impl SplitExec {
-    pub fn new() -> anyhow::Result<SplitExec> {
+    /// # Errors
+    /// When the system refuses a thread.
+    pub fn new() -> Result<SplitExec, Refused> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(2)
             .thread_name(|i| SPLIT_NAMES[i].to_string())
             .build()
-            .map_err(|e| refused("the two split threads", &e))?;
+            .map_err(|e| Refused::new("the two split threads".into(), &e))?;
         Ok(SplitExec { pool })
     }
 

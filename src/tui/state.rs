@@ -321,6 +321,9 @@ impl AppState {
         // The engine's notice (a limit it hit) answers the commands; with
         // none, the key's own notice stays, unless it said work was under way.
         if applied {
+            // Threads the system refused fall back to what exists.
+            self.threading = snap.settings.threading;
+            self.threads = snap.settings.threads;
             if snap.notice.is_some() {
                 self.notice.clone_from(&snap.notice);
             } else if self.under_way {

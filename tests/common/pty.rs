@@ -33,6 +33,18 @@ pub fn start_with(
     (rows, cols): (u16, u16),
     term: &str,
 ) -> App {
+    let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_ballpit"));
+    cmd.args(args);
+    start_command(cmd, read_until, (rows, cols), term)
+}
+
+/// Start `cmd` (e.g. a shell that sets a limit and execs the binary).
+pub fn start_command(
+    mut cmd: CommandBuilder,
+    read_until: Option<&'static str>,
+    (rows, cols): (u16, u16),
+    term: &str,
+) -> App {
     let pty = native_pty_system()
         .openpty(PtySize {
             rows,
@@ -41,8 +53,6 @@ pub fn start_with(
             pixel_height: 0,
         })
         .expect("openpty");
-    let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_ballpit"));
-    cmd.args(args);
     cmd.env("TERM", term);
     cmd.env_remove("NO_COLOR");
     let child = pty.slave.spawn_command(cmd).expect("spawn ballpit");
