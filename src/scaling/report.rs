@@ -50,6 +50,15 @@ pub fn markdown(s: &Sweep) -> String {
         );
     }
     out.push('\n');
+    if let Some(&start) = s.load_average.first()
+        && start >= 0.5 * p.cores as f64
+    {
+        let _ = writeln!(
+            out,
+            "WARNING: the host was busy before the sweep began (load {start:.2} on {} cores): other work took cores the runs needed, so these figures measure the host as much as the threading; run again on an idle host.",
+            p.cores
+        );
+    }
     let differ: Vec<String> = s
         .rows
         .iter()
