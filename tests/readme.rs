@@ -412,6 +412,8 @@ fn every_readme_command_runs_as_written_and_changes_no_tracked_file() {
         "end.csv",
         "tradeoff-out/tradeoff.csv",
         "tradeoff-out/tradeoff.svg",
+        "scaling-out/scaling.csv",
+        "scaling-out/scaling.svg",
     ] {
         assert!(
             work.join(f).exists(),

@@ -472,8 +472,9 @@ impl Engine {
             Err(refused) if self.running => {
                 let kept = self.keep_going();
                 frame.notice = Some(format!(
-                    "cannot start {}: the system refused a thread ({}); {kept}",
-                    refused.what, refused.cause
+                    "the system refused {} ({}): {kept}",
+                    refused.what,
+                    refused.short_cause()
                 ));
                 self.exec()
                     .map_err(|e| crate::error::BadInput(e.to_string()))?

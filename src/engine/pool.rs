@@ -80,6 +80,18 @@ impl Refused {
     }
 }
 
+impl Refused {
+    /// The cause for a notice of two short rows: `os error 11` out of
+    /// `Resource temporarily unavailable (os error 11)`.
+    #[must_use]
+    pub fn short_cause(&self) -> &str {
+        match self.cause.rfind("(os error") {
+            Some(i) => self.cause[i + 1..].trim_end_matches(')'),
+            None => &self.cause,
+        }
+    }
+}
+
 impl std::fmt::Display for Refused {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
