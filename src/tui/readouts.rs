@@ -185,7 +185,16 @@ impl Readouts<'_> {
             format!("{:<8.0}", st.steps_per_second)
         };
         if !self.state.flat_out {
-            return now;
+            // The compact form has no tick row of its own to say the
+            // simulated seconds per second: they go with the steps.
+            return if compact {
+                format!(
+                    "{now} {:.2}s/s",
+                    st.steps_per_second * self.snap.settings.dt
+                )
+            } else {
+                now
+            };
         }
         match st.speed_up(&self.state.mode_label()) {
             Some(x) if compact => format!("{now} {x:.2}x"),
