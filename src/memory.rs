@@ -83,19 +83,9 @@ fn parse_kb(text: &str, key: &str) -> Option<u64> {
 /// Whether `count` spheres fit in `budget` bytes free; the message says how
 /// much they would need.
 pub fn check(count: usize, model: Option<ModelKind>, free: Option<u64>) -> Result<(), String> {
-    let Some(free) = free else {
+    let Some((need, allowed, free)) = refusal(count, model, free) else {
         return Ok(());
     };
-    let need = need(count, model);
-    // The fixed cost once, then a share of the rest for the spheres.
-    let allowed = if free < FIXED_BYTES {
-        0
-    } else {
-        FIXED_BYTES + ((free - FIXED_BYTES) as f64 * SHARE) as u64
-    };
-    if need <= allowed {
-        return Ok(());
-    }
     Err(format!(
         "{count} spheres would need about {} of memory{}, more than the {} a run may plan on: {} for the process and half of the rest of the {} available (free memory, or what ulimit -v leaves if lower)",
         mib(need),
@@ -104,6 +94,31 @@ pub fn check(count: usize, model: Option<ModelKind>, free: Option<u64>) -> Resul
         mib(FIXED_BYTES),
         mib(free)
     ))
+}
+
+/// The screen's notice for a count [`check`] refuses, short enough for two
+/// rows of the readouts panel (the command line gives the whole story).
+pub fn count_notice(count: usize, free: Option<u64>) -> Option<String> {
+    let (need, allowed, _) = refusal(count, None, free)?;
+    Some(format!(
+        "count limit: {count} spheres need {}, over the {} a run may use",
+        mib(need),
+        mib(allowed)
+    ))
+}
+
+/// What `count` spheres need, what a run may plan on and what is free,
+/// when the first is more than the second.
+fn refusal(count: usize, model: Option<ModelKind>, free: Option<u64>) -> Option<(u64, u64, u64)> {
+    let free = free?;
+    let need = need(count, model);
+    // The fixed cost once, then a share of the rest for the spheres.
+    let allowed = if free < FIXED_BYTES {
+        0
+    } else {
+        FIXED_BYTES + ((free - FIXED_BYTES) as f64 * SHARE) as u64
+    };
+    (need > allowed).then_some((need, allowed, free))
 }
 
 /// What `count` spheres would take and what the machine has, for a message
@@ -168,5 +183,13 @@ mod tests {
         assert!(check(45_000, Some(ModelKind::Swept), tight).is_err());
         assert!(check(0, Some(ModelKind::Swept), Some(8 << 20)).is_err());
         assert_eq!(need(usize::MAX, None), u64::MAX);
+        // The screen's short form refuses the same counts.
+        // The screen's short form: the app's count (hungriest model and the
+        // screen's copies, 415 bytes a sphere) against the same share.
+        assert!(count_notice(20_000, tight).is_none());
+        assert_eq!(
+            count_notice(1_000_000, tight).unwrap(),
+            "count limit: 1000000 spheres need 411 MiB, over the 28 MiB a run may use"
+        );
     }
 }

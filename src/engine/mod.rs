@@ -432,9 +432,10 @@ impl Engine {
                     // Any model may run next: plan for the hungriest. Only
                     // growth needs the check (and its read of /proc).
                     if n > frame.world.spheres.len()
-                        && let Err(e) = crate::memory::check(n, None, crate::memory::available())
+                        && let Some(why) =
+                            crate::memory::count_notice(n, crate::memory::available())
                     {
-                        frame.notice = Some(format!("count limit: {e}"));
+                        frame.notice = Some(why);
                         continue;
                     }
                     let w = &mut frame.world;

@@ -45,8 +45,16 @@ pub struct Areas {
     pub main: Rect,
 }
 
-/// The layout for `area`, or None when it is below the minimum.
+/// The layout for `area` with no notice, or None when it is below the
+/// minimum.
 pub fn areas(area: Rect, report: &CpuReport) -> Option<Areas> {
+    areas_with(area, report, None)
+}
+
+/// The layout for `area` showing `notice`: one longer than the readouts'
+/// kept rows takes more, from the threads' blank rows first, never so many
+/// that a thread is hidden.
+pub fn areas_with(area: Rect, report: &CpuReport, notice: Option<&str>) -> Option<Areas> {
     if area.width < MIN_WIDTH || area.height < MIN_HEIGHT {
         return None;
     }
@@ -54,7 +62,8 @@ pub fn areas(area: Rect, report: &CpuReport) -> Option<Areas> {
     let panel = PANEL_WIDTH.max((area.width.saturating_add(2) / 3).min(PANEL_MAX));
     let [canvas, side] =
         Layout::horizontal([Constraint::Fill(1), Constraint::Length(panel)]).areas(main);
-    let top = readouts_height(side, report);
+    let extra = readouts::notice_rows(notice, panel - 2) - readouts::NOTICE_ROWS;
+    let top = readouts_height(side, report, extra);
     let [readouts, threads] =
         Layout::vertical([Constraint::Length(top), Constraint::Fill(1)]).areas(side);
     Some(Areas {
@@ -67,20 +76,29 @@ pub fn areas(area: Rect, report: &CpuReport) -> Option<Areas> {
 }
 
 /// Whole readouts when the threads still fit beside them (a row each, or
-/// a grid with a cell each), else compact ones.
-fn readouts_height(side: Rect, report: &CpuReport) -> u16 {
+/// a grid with a cell each), else compact ones; `extra` rows more for a
+/// long notice, as far as the threads can spare them.
+fn readouts_height(side: Rect, report: &CpuReport, extra: u16) -> u16 {
     let inner_w = usize::from(side.width.saturating_sub(2));
     let threads = threads::full_height(report).min(threads::compact_height(report, inner_w));
-    if side.height >= readouts::HEIGHT + threads {
+    let top = if side.height >= readouts::HEIGHT + extra + threads {
         readouts::HEIGHT
     } else {
         readouts::COMPACT_HEIGHT
-    }
+    };
+    let spare = side.height.saturating_sub(top + threads);
+    top + extra.min(spare)
 }
 
 pub fn draw(frame: &mut Frame, raster: &mut Raster, v: &View) {
     let area = frame.area();
-    let Some(a) = areas(area, v.report) else {
+    let panel = Readouts {
+        state: v.state,
+        snap: v.snap,
+        stats: v.stats,
+        palette: v.palette,
+    };
+    let Some(a) = areas_with(area, v.report, panel.notice().as_deref()) else {
         let msg: Vec<Line> =
             super::caps::size_message(area.width, area.height, (MIN_WIDTH, MIN_HEIGHT))
                 .into_iter()
@@ -110,15 +128,7 @@ pub fn draw(frame: &mut Frame, raster: &mut Raster, v: &View) {
         };
         raster.draw(&v.snap.spheres, &scene, a.canvas, frame.buffer_mut());
     }
-    frame.render_widget(
-        Readouts {
-            state: v.state,
-            snap: v.snap,
-            stats: v.stats,
-            palette: v.palette,
-        },
-        a.readouts,
-    );
+    frame.render_widget(panel, a.readouts);
     frame.render_widget(
         Threads {
             report: v.report,

@@ -24,6 +24,7 @@ pub mod state;
 pub mod term_input;
 pub mod theme;
 pub mod threads;
+pub mod wrap;
 pub mod writer;
 
 pub use run::{AfterFirstFrame, RunExtras, run, run_with};

@@ -2,14 +2,16 @@
 //! change without the layout moving.
 use super::state::{AppState, representative_radius};
 use super::theme::Palette;
+use super::wrap::wrap;
 use crate::engine::{Snapshot, Threading, physics_threads};
 use crate::physics::ModelKind;
 use crate::physics::auto::Choice;
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
 use ratatui::text::{Line, Span};
-use ratatui::widgets::{Block, Paragraph, Widget, Wrap};
+use ratatui::widgets::{Block, Paragraph, Widget};
 use std::time::Duration;
+use unicode_width::UnicodeWidthStr;
 
 /// Figures the frame loop measures (the rest come from the snapshot).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -87,8 +89,10 @@ impl Stats {
 /// Rows of figures in the full form, and of the compact one.
 const FULL_ROWS: u16 = 16;
 const COMPACT_ROWS: u16 = 7;
-/// Rows kept for a notice, so a long one wraps instead of being cut.
-const NOTICE_ROWS: u16 = 2;
+/// Rows kept for a notice, so a long one wraps instead of being cut (every
+/// notice of bounded length fits two rows of the narrowest panel,
+/// `tests/notices.rs`; a longer one takes rows from the threads).
+pub const NOTICE_ROWS: u16 = 2;
 /// The full panel: its rows, the notice and the border.
 pub const HEIGHT: u16 = FULL_ROWS + NOTICE_ROWS + 2;
 /// The compact panel, for short terminals.
@@ -181,7 +185,16 @@ impl Readouts<'_> {
             format!("{:<8.0}", st.steps_per_second)
         };
         if !self.state.flat_out {
-            return now;
+            // The compact form has no tick row of its own to say the
+            // simulated seconds per second: they go with the steps.
+            return if compact {
+                format!(
+                    "{now} {:.2}s/s",
+                    st.steps_per_second * self.snap.settings.dt
+                )
+            } else {
+                now
+            };
         }
         match st.speed_up(&self.state.mode_label()) {
             Some(x) if compact => format!("{now} {x:.2}x"),
@@ -383,13 +396,14 @@ impl Readouts<'_> {
         ]
     }
 
-    /// The line under the figures: pause, a notice, or the event cap.
-    fn notice(&self) -> Option<String> {
+    /// What shows under the figures: the last key's notice (it answers
+    /// the key, paused or not), the pause, or the event cap.
+    pub fn notice(&self) -> Option<String> {
         let s = self.state;
-        if s.paused {
-            Some(" PAUSED (space resumes) ".into())
-        } else if let Some(n) = &s.notice {
-            Some(format!(" {n} "))
+        if let Some(n) = &s.notice {
+            Some(n.clone())
+        } else if s.paused {
+            Some("PAUSED (space resumes)".into())
         } else if self.snap.counters.capped_steps > 0 {
             // A capped step skipped contacts: say so, it explains overlaps.
             let c = &self.snap.counters;
@@ -399,13 +413,26 @@ impl Readouts<'_> {
                 "event cap"
             };
             Some(format!(
-                " {why} hit in {} steps: contacts skipped, overlaps possible (lower --dt or --speed) ",
+                "{why} hit in {} steps, overlaps possible: lower --dt or --speed",
                 c.capped_steps
             ))
         } else {
             None
         }
     }
+}
+
+/// A notice's rows in a panel of inner `width`: a column of margin each
+/// side, so in reverse video (no colour) it reads as a bar.
+pub fn notice_lines(notice: &str, width: u16) -> Vec<String> {
+    wrap(notice, usize::from(width.saturating_sub(2)))
+}
+
+/// Rows the panel keeps for `notice` at an inner `width`: the kept ones,
+/// or more when it needs them (the layout takes them from the threads).
+pub fn notice_rows(notice: Option<&str>, width: u16) -> u16 {
+    let rows = notice.map_or(0, |n| notice_lines(n, width).len());
+    u16::try_from(rows).unwrap_or(u16::MAX).max(NOTICE_ROWS)
 }
 
 /// The model, and the parts it cut its last step into when it did (fast
@@ -424,13 +451,18 @@ fn model_row(model: ModelKind, parts: u32, choice: Option<&Choice>) -> String {
 }
 
 impl Widget for Readouts<'_> {
-    /// The full form when the area has room for it, else the compact one;
-    /// the notice wraps in the rows left under the figures.
+    /// The full form when the area has room for it and the notice, else
+    /// the compact one; the notice wraps in the rows under the figures.
     fn render(self, area: Rect, buf: &mut Buffer) {
         let block = Block::bordered().title(" ballpit ");
         let inner = block.inner(area);
         block.render(area, buf);
-        let lines = if inner.height >= FULL_ROWS + NOTICE_ROWS && inner.width >= 42 {
+        let notice = self.notice().map(|n| notice_lines(&n, inner.width));
+        let need = notice
+            .as_ref()
+            .map_or(0, |n| n.len() as u16)
+            .max(NOTICE_ROWS);
+        let lines = if inner.height >= FULL_ROWS + need && inner.width >= 42 {
             self.lines()
         } else {
             self.compact_lines()
@@ -443,16 +475,32 @@ impl Widget for Readouts<'_> {
             },
             buf,
         );
-        if let Some(n) = self.notice() {
-            let r = Rect {
+        let Some(mut notice) = notice else {
+            return;
+        };
+        // Cut only when the layout could not give the rows (the threads
+        // keep theirs): the last row then ends in an ellipsis.
+        let room = usize::from(inner.height - rows);
+        if notice.len() > room {
+            notice.truncate(room);
+            if let Some(last) = notice.last_mut() {
+                while last.width() + 3 > usize::from(inner.width) && last.pop().is_some() {}
+                last.push('…');
+            }
+        }
+        let style = self.palette.alert();
+        let text: Vec<Line> = notice
+            .into_iter()
+            .map(|row| Line::from(Span::styled(format!(" {row} "), style)))
+            .collect();
+        Paragraph::new(text).render(
+            Rect {
                 y: inner.y + rows,
                 height: inner.height - rows,
                 ..inner
-            };
-            Paragraph::new(Span::styled(n, self.palette.alert()))
-                .wrap(Wrap { trim: false })
-                .render(r, buf);
-        }
+            },
+            buf,
+        );
     }
 }
 
