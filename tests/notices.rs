@@ -126,6 +126,16 @@ fn engine_notices() -> Vec<String> {
     for free in [0, 100 << 20, need - 1] {
         out.extend(ballpit::memory::count_notice(MAX_COUNT, Some(free)));
     }
+    // Threads the system refused while running, and what runs instead.
+    let refused = ballpit::engine::Refused {
+        what: format!("{MAX_THREADS} pool threads"),
+        cause: "Resource temporarily unavailable (os error 11)".into(),
+    };
+    let kept = [
+        ballpit::engine::KEPT_WORKER.to_string(),
+        ballpit::engine::kept_pool(MAX_THREADS - 1),
+    ];
+    out.extend(kept.iter().map(|k| refused.notice(k)));
     // Reset: no start kept, a start that rebuilt differently, one that failed.
     let mut e = Engine::headless(world(), s).unwrap();
     out.extend(frame(&mut e, Command::Reset));

@@ -20,7 +20,7 @@ mod snapshot;
 mod start;
 mod worker;
 
-pub use pool::{PoolExec, Refused, SPLIT_NAMES, SplitExec};
+pub use pool::{KEPT_WORKER, PoolExec, Refused, SPLIT_NAMES, SplitExec, kept_pool};
 pub use snapshot::{Snapshot, SphereView};
 pub use start::Rebuild;
 
@@ -472,11 +472,7 @@ impl Engine {
             Ok(exec) => exec,
             Err(refused) if self.running => {
                 let kept = self.keep_going();
-                frame.notice = Some(format!(
-                    "the system refused {} ({}): {kept}",
-                    refused.what,
-                    refused.short_cause()
-                ));
+                frame.notice = Some(refused.notice(&kept));
                 self.exec()
                     .map_err(|e| crate::error::BadInput(e.to_string()))?
             }
@@ -491,10 +487,10 @@ impl Engine {
     fn keep_going(&mut self) -> String {
         if let (Some(p), Threading::Pool) = (&self.pool, self.settings.threading) {
             self.settings.threads = p.threads();
-            format!("kept the {} pool threads there are", p.threads())
+            pool::kept_pool(p.threads())
         } else {
             self.settings.threading = Threading::Worker;
-            "running on worker".into()
+            pool::KEPT_WORKER.into()
         }
     }
 

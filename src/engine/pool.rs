@@ -92,6 +92,27 @@ impl Refused {
     }
 }
 
+/// What the engine falls back to when threads are refused while running.
+pub const KEPT_WORKER: &str = "running on worker";
+
+/// The fallback to the pool that exists.
+#[must_use]
+pub fn kept_pool(threads: usize) -> String {
+    format!("kept the {threads} it has")
+}
+
+impl Refused {
+    /// The screen's notice: what was refused and what runs instead.
+    #[must_use]
+    pub fn notice(&self, kept: &str) -> String {
+        format!(
+            "the system refused {} ({}): {kept}",
+            self.what,
+            self.short_cause()
+        )
+    }
+}
+
 impl std::fmt::Display for Refused {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
