@@ -44,6 +44,7 @@
 pub mod body;
 pub mod calendar;
 pub mod cell_grid;
+pub mod ids;
 pub mod large;
 pub mod neighbour_lists;
 mod overlap;
@@ -61,9 +62,10 @@ use body::Bodies;
 pub use calendar::Calendar;
 use cell_grid::CellGrid;
 use glam::DVec3;
+use ids::{Label, WorldId};
 use neighbour_lists::NeighbourLists;
 pub use queue::{EventQueue, Tournament};
-use schedule::{Event, Kind, Predictor, Slot};
+use schedule::{Event, Kind, Predictor, Queued, Slot};
 
 /// Events (contacts, wall hits, relists, stale predictions) a step may take,
 /// at least; scenes add [`EVENT_CAP_PER_SPHERE`] per sphere.
@@ -72,8 +74,6 @@ pub const EVENT_CAP_PER_SPHERE: u64 = 100;
 /// Internal times are kept relative to an origin that moves with the frames,
 /// so lazy positions `x + v (t - t_i)` never subtract large times.
 const ORIGIN_SPAN: f64 = 1.0;
-/// "No sphere" / "no cell" in the broad phases' `u32` indices.
-pub const NONE: u32 = u32::MAX;
 
 /// Above this packing fraction the broad phase is neighbour lists (a
 /// sphere's free path is short, so it meets its skin's edge rarely and
@@ -125,14 +125,15 @@ pub struct EventDriven<Q: EventQueue> {
     /// World index of each body: bodies are kept in a spatial order (sorted
     /// by cell when loaded), so neighbours sit close in memory and a
     /// prediction touches few cache lines.
-    order: Vec<u32>,
+    order: Vec<WorldId>,
     /// Each sphere's event; in cell mode its best contact or wall event
     /// (absolute time), kept apart from its crossing so a crossing rescans
     /// only new cells, and which of the two the queue holds.
     slots: Vec<Slot>,
     queue: Q,
     broad: Broad,
-    /// Scratch for the candidates a prediction gathers.
+    /// Scratch for the candidates a prediction gathers: labels, as the
+    /// cell grid packs them ([`Label::raw`]).
     candidates: Vec<u32>,
     size: f64,
     /// Absolute time of internal time zero.
@@ -207,7 +208,8 @@ impl<Q: EventQueue> EventDriven<Q> {
             Broad::Cells(cells) => cells.heap_bytes(),
         };
         self.bodies.heap_bytes()
-            + (self.order.capacity() + self.candidates.capacity()) * 4
+            + self.order.capacity() * size_of::<WorldId>()
+            + self.candidates.capacity() * size_of::<u32>()
             + self.slots.capacity() * size_of::<Slot>()
             + self.queue.heap_bytes()
             + broad
@@ -230,7 +232,7 @@ impl<Q: EventQueue> EventDriven<Q> {
             && world.time == self.synced_time
             && world.spheres.len() == self.bodies.len()
             && self.order.iter().zip(self.bodies.iter()).all(|(&k, b)| {
-                let s = &world.spheres[k as usize];
+                let s = &world.spheres[k.index()];
                 let kind = self.bodies.species_of(b);
                 s.pos == b.pos && s.vel == b.vel && s.radius == kind.radius && s.mass == kind.mass
             })
@@ -241,9 +243,10 @@ impl<Q: EventQueue> EventDriven<Q> {
         self.origin = world.time;
         self.synced_time = world.time;
         self.synced_generation = world.generation();
-        self.order = renumber::spatial_order(world.spheres.iter().map(|s| s.pos), world.size);
+        let positions = world.spheres.iter().map(|s| s.pos);
+        self.order = renumber::spatial_order(positions, world.size, WorldId::at);
         self.bodies =
-            Bodies::from_spheres(self.order.iter().map(|&k| &world.spheres[k as usize]), 0.0);
+            Bodies::from_spheres(self.order.iter().map(|&k| &world.spheres[k.index()]), 0.0);
         self.sorted_at = self.stats.crossings + self.stats.relists;
         self.reschedule_all();
     }
@@ -276,9 +279,9 @@ impl<Q: EventQueue> EventDriven<Q> {
             self.broad = Broad::Cells(cells);
         }
         self.queue.reset(n);
-        for i in 0..n {
+        for i in self.bodies.labels() {
             let t = self.predict(i);
-            self.queue.set_leaf(i, t);
+            self.queue.set_leaf(i.index(), t);
         }
         self.queue.rebuild();
         self.valid = true;
@@ -286,7 +289,7 @@ impl<Q: EventQueue> EventDriven<Q> {
 
     /// Sphere `i`'s next event, into its slot; returns its absolute time.
     #[inline]
-    fn predict(&mut self, i: usize) -> f64 {
+    fn predict(&mut self, i: Label) -> f64 {
         let a = &self.bodies[i];
         match &self.broad {
             Broad::Lists(nl) => {
@@ -300,7 +303,7 @@ impl<Q: EventQueue> EventDriven<Q> {
                     p.pair(l.j);
                 }
                 let (t, ev) = p.finish();
-                self.slots[i] = Slot { t, ev };
+                self.slots[i.index()] = Slot { t, ev };
                 t
             }
             Broad::Cells(cells) => {
@@ -308,12 +311,12 @@ impl<Q: EventQueue> EventDriven<Q> {
                 let mut p = Predictor::new(a, &self.bodies, self.size, f64::INFINITY, idle);
                 let n = cells.candidates(i, p.radius(), &mut self.candidates);
                 for &j in &self.candidates[..n] {
-                    if j as usize != i {
-                        p.pair(j);
+                    if j != i.raw() {
+                        p.pair(Label::from_raw(j));
                     }
                 }
                 let (t, ev) = p.finish();
-                self.slots[i] = Slot { t, ev };
+                self.slots[i.index()] = Slot { t, ev };
                 self.with_crossing(i)
             }
         }
@@ -322,35 +325,34 @@ impl<Q: EventQueue> EventDriven<Q> {
     /// Cell mode: the earlier of the pending event and the next crossing
     /// (the crossing first on a tie), marked in the slot; returns its time.
     #[inline]
-    fn with_crossing(&mut self, i: usize) -> f64 {
+    fn with_crossing(&mut self, i: Label) -> f64 {
         let Broad::Cells(cells) = &self.broad else {
             unreachable!("crossings only in cell mode")
         };
         let a = &self.bodies[i];
         let (tc, ev) = cells.next_event(i, a);
         let tc = a.t + tc;
-        let slot = &mut self.slots[i];
+        let slot = &mut self.slots[i.index()];
         let tp = slot.t;
         // By index: which comes first is random, and a branch on it
         // mispredicted a third of the time.
-        let first = tc <= tp;
-        let broad = 8 | ev.mask | u8::from(ev.kind == Kind::Relist) << 4;
-        slot.ev.cross = [0, broad][usize::from(first)];
-        [tp, tc][usize::from(first)]
+        let first = usize::from(tc <= tp);
+        slot.ev.queued = [Queued::PENDING, Queued::broad(&ev)][first];
+        [tp, tc][first]
     }
 
     #[inline]
-    fn schedule(&mut self, i: usize) {
+    fn schedule(&mut self, i: Label) {
         let t = self.predict(i);
-        self.queue.update(i, t);
+        self.queue.update(i.index(), t);
     }
 
     /// Cell mode, after sphere `i` crossed as `mask` says: its pending event
     /// still holds unless its partner has moved on; only the new layer of
     /// cells needs checking.
-    fn after_crossing(&mut self, i: usize, mask: u8) {
-        let (tp, evp) = self.slots[i].pending();
-        if evp.kind == Kind::Pair && self.bodies[evp.partner as usize].count != evp.partner_count {
+    fn after_crossing(&mut self, i: Label, mask: u8) {
+        let (tp, evp) = self.slots[i.index()].pending();
+        if evp.kind == Kind::Pair && self.bodies[evp.partner].count != evp.partner_count {
             self.schedule(i);
             return;
         }
@@ -361,12 +363,12 @@ impl<Q: EventQueue> EventDriven<Q> {
         let mut p = Predictor::resume(a, &self.bodies, tp - a.t, evp);
         let n = cells.new_candidates(i, mask, &mut self.candidates);
         for &j in &self.candidates[..n] {
-            p.pair(j);
+            p.pair(Label::from_raw(j));
         }
         let (t, ev) = p.finish();
-        self.slots[i] = Slot { t, ev };
+        self.slots[i.index()] = Slot { t, ev };
         let t = self.with_crossing(i);
-        self.queue.update(i, t);
+        self.queue.update(i.index(), t);
     }
 
     /// Move the time origin to `world_time`: every body is moved to it first.
@@ -396,6 +398,7 @@ impl<Q: EventQueue> EventDriven<Q> {
         let mut done = 0u64;
         loop {
             let (t, i) = self.queue.peek();
+            let i = Label::at(i);
             if t.is_nan() || t > target {
                 return true;
             }
@@ -403,11 +406,11 @@ impl<Q: EventQueue> EventDriven<Q> {
                 return false;
             }
             done += 1;
-            let ev = self.slots[i].queued();
+            let ev = self.slots[i.index()].queued();
             self.bodies[i].advance(t);
             match ev.kind {
                 Kind::Pair => {
-                    let j = ev.partner as usize;
+                    let j = ev.partner;
                     if self.bodies[j].count != ev.partner_count {
                         self.stats.stale += 1;
                         self.schedule(i);
@@ -418,7 +421,7 @@ impl<Q: EventQueue> EventDriven<Q> {
                     self.collide(i, j, c);
                     let ti = self.predict(i);
                     let tj = self.predict(j);
-                    self.queue.update_two(i, ti, j, tj);
+                    self.queue.update_two(i.index(), ti, j.index(), tj);
                 }
                 Kind::Wall => {
                     self.stats.walls += 1;
@@ -463,7 +466,7 @@ impl<Q: EventQueue> EventDriven<Q> {
         }
     }
 
-    fn collide(&mut self, i: usize, j: usize, c: &mut Counters) {
+    fn collide(&mut self, i: Label, j: Label, c: &mut Counters) {
         let mut a = self.bodies.sphere(i);
         let mut b = self.bodies.sphere(j);
         let before = [a.vel, b.vel];
@@ -474,13 +477,13 @@ impl<Q: EventQueue> EventDriven<Q> {
                 // contact (labels decide that on a tie; `resolve_pair` gives
                 // the same velocities either way round, bit for bit), so
                 // observers see the same contact whatever the labels.
-                let (ids, spheres) = ([self.order[i], self.order[j]], [&a, &b]);
+                let (ids, spheres) = ([self.order[i.index()], self.order[j.index()]], [&a, &b]);
                 let lo = usize::from(ids[1] < ids[0]);
                 let (p, q) = (spheres[lo], spheres[1 - lo]);
                 f(&Contact {
                     time: self.origin + self.bodies[i].t,
-                    i: ids[lo] as usize,
-                    j: ids[1 - lo] as usize,
+                    i: ids[lo].index(),
+                    j: ids[1 - lo].index(),
                     pos_i: p.pos,
                     pos_j: q.pos,
                     impulse: p.mass * (p.vel - before[lo]).length(),
@@ -496,7 +499,7 @@ impl<Q: EventQueue> EventDriven<Q> {
 
     /// After a capped step: finish it by free flight with wall bounces.
     fn fly_all(&mut self, target: f64, c: &mut Counters) {
-        for i in 0..self.bodies.len() {
+        for i in self.bodies.labels() {
             let mut s = self.bodies.sphere(i);
             let (imp, hits) = fly(&mut s, self.size, target - self.bodies[i].t);
             c.wall_momentum += imp;
@@ -510,7 +513,7 @@ impl<Q: EventQueue> EventDriven<Q> {
         let now = world.time - self.origin;
         for (&k, b) in self.order.iter().zip(self.bodies.iter_mut()) {
             b.advance(now);
-            let s = &mut world.spheres[k as usize];
+            let s = &mut world.spheres[k.index()];
             s.pos = b.pos;
             s.vel = b.vel;
         }
