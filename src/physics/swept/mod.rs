@@ -40,7 +40,6 @@ pub use parts::{ADDED_PAIRS, parts};
 pub use rounds::RoundStats;
 use rounds::Rounds;
 
-const NONE: u32 = u32::MAX;
 /// Reach balls are widened by this much so touching spheres, whose distance
 /// rounds either way, are always seen.
 const REACH_SLACK: f64 = 1.0 + 1e-9;
