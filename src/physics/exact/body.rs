@@ -97,6 +97,7 @@ impl Bodies {
     }
 
     /// The bodies, to be put in a new order.
+    #[cfg(feature = "experiments")]
     pub fn list_mut(&mut self) -> &mut Vec<Body> {
         &mut self.list
     }

@@ -1,9 +1,9 @@
-//! Spatial renumbering: the event loop keeps its spheres in the order of
-//! their cells, so a sphere's neighbours sit close to it in every
-//! per-sphere array and a prediction touches few cache lines. The load
-//! sorts them; as they drift, [`EventDriven::renumber`] sorts them again
-//! (when asked: `with_renumbering(true)`; at 100k and 1M spheres it cost
-//! more than it saved, see docs/benchmarks.md "exact at scale").
+//! Spatial renumbering (feature `experiments`): the load sorts the spheres
+//! in space ([`super::spatial`]); as they drift, [`EventDriven::renumber`]
+//! sorts them again (when asked: `with_renumbering(true)`; at 100k and 1M
+//! spheres it cost more than it saved, see docs/benchmarks.md "exact at
+//! scale"). The pins of `tests/exact_pin.rs` run with it on, so they hold
+//! it to changing nothing.
 //! Only labels change: every record moves with its sphere and keeps its
 //! value (and each cell and list keeps its order), and `order` maps the
 //! labels back to the world's ids, so the world, the CSV and the screen
@@ -12,41 +12,8 @@ use super::body::Body;
 use super::ids::Label;
 use super::queue::EventQueue;
 use super::schedule::{Event, Kind};
+use super::spatial::spatial_order;
 use super::{Broad, EventDriven};
-use glam::DVec3;
-
-/// The spheres' numbers (`number(i)` of the `i`th position: world ids at
-/// load, labels at a renumbering) in the order of their cells on a grid of
-/// about one cell a sphere, z then y then x; ties keep their current order
-/// (a counting sort: linear, and stable). `perm[new] = old`.
-#[must_use]
-pub fn spatial_order<T: Copy + Default>(
-    positions: impl ExactSizeIterator<Item = DVec3>,
-    size: f64,
-    number: impl Fn(usize) -> T,
-) -> Vec<T> {
-    let n = positions.len();
-    let per_side = ((n as f64).cbrt().ceil() as usize).max(1);
-    let cell = |x: f64| ((x / size * per_side as f64) as usize).min(per_side - 1);
-    let key = |p: DVec3| {
-        cell(p.x.max(0.0)) + per_side * (cell(p.y.max(0.0)) + per_side * cell(p.z.max(0.0)))
-    };
-    let keys: Vec<u32> = positions.map(|p| key(p) as u32).collect();
-    let mut start = vec![0u32; per_side * per_side * per_side + 1];
-    for &k in &keys {
-        start[k as usize + 1] += 1;
-    }
-    for c in 1..start.len() {
-        start[c] += start[c - 1];
-    }
-    let mut perm = vec![T::default(); n];
-    for (i, &k) in keys.iter().enumerate() {
-        let at = &mut start[k as usize];
-        perm[*at as usize] = number(i);
-        *at += 1;
-    }
-    perm
-}
 
 /// The inverse of a permutation: `inv[old] = new`.
 #[must_use]
@@ -112,6 +79,19 @@ fn relabel(ev: &mut Event, inv: &[Label]) {
 }
 
 impl<Q: EventQueue> EventDriven<Q> {
+    /// Renumber, if on, once the spheres have crossed about a cell each on
+    /// average since the last sort.
+    pub(super) fn renumber_if_drifted(&mut self) {
+        let moved = self.stats.crossings + self.stats.relists;
+        if self.valid
+            && self.hooks.renumbering
+            && moved - self.hooks.sorted_at >= self.bodies.len().max(1) as u64
+        {
+            self.renumber();
+            self.hooks.sorted_at = moved;
+        }
+    }
+
     /// Sort the spheres by cell again (their positions at their own time
     /// stamps), moving every per-sphere record with its sphere.
     pub(super) fn renumber(&mut self) {
@@ -165,23 +145,5 @@ mod tests {
         for (new, &old) in perm.iter().enumerate() {
             assert_eq!(inv[old.index()], Label::at(new));
         }
-    }
-
-    #[test]
-    fn spatial_order_sorts_by_cell_and_keeps_ties_in_order() {
-        // Two per cell of a 2-a-side grid, given in reverse cell order.
-        let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
-        let pos = [
-            p(0.9, 0.9, 0.9),
-            p(0.1, 0.1, 0.1),
-            p(0.6, 0.1, 0.1),
-            p(0.2, 0.2, 0.2),
-            p(0.1, 0.1, 0.9),
-            p(0.1, 0.9, 0.1),
-            p(0.7, 0.7, 0.7),
-            p(0.3, 0.3, 0.3),
-        ];
-        let perm = spatial_order(pos.into_iter(), 1.0, |i| i);
-        assert_eq!(perm, [1, 3, 7, 2, 5, 4, 0, 6]);
     }
 }

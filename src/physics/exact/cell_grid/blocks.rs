@@ -205,6 +205,7 @@ impl CellBlocks {
 
     /// The spheres are relabelled (`inv[old] = new`); every cell keeps its
     /// order.
+    #[cfg(feature = "experiments")]
     pub fn relabel(&mut self, inv: &[Label]) {
         let new = |j: u32| inv[j as usize].raw();
         for c in 0..self.slot.len() {

@@ -16,6 +16,7 @@ pub mod blocks;
 use super::body::{Bodies, Body};
 use super::ids::Label;
 use super::large::{BIG_FACTOR, split_big, time_to_leave};
+#[cfg(feature = "experiments")]
 use super::renumber::apply;
 use super::schedule::{Event, Kind};
 use blocks::CellBlocks;
@@ -244,6 +245,7 @@ impl CellGrid {
 
     /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
     /// every cell keeps its order.
+    #[cfg(feature = "experiments")]
     pub fn relabel(&mut self, perm: &[Label], inv: &[Label]) {
         self.list.relabel(inv);
         apply(&mut self.place, perm);

@@ -4,6 +4,7 @@
 //! gathers cells far more often, keeps its cells in
 //! [`CellBlocks`](crate::physics::exact::cell_grid::blocks::CellBlocks) instead.
 use crate::physics::exact::ids::{Cell, Label};
+#[cfg(feature = "experiments")]
 use crate::physics::exact::renumber::apply;
 
 #[derive(Clone, Debug, Default)]
@@ -69,6 +70,7 @@ impl CellChains {
 
     /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
     /// every chain keeps its order.
+    #[cfg(feature = "experiments")]
     pub fn relabel(&mut self, perm: &[Label], inv: &[Label]) {
         for v in [&mut self.head, &mut self.next, &mut self.prev] {
             for x in v.iter_mut().filter(|x| **x != Label::NONE) {

@@ -19,6 +19,7 @@ pub mod chains;
 use super::body::{Bodies, Body};
 use super::ids::{Cell, Label};
 use super::large::{BIG_FACTOR, split_big, time_to_leave};
+#[cfg(feature = "experiments")]
 use super::renumber::{apply, apply_chunks};
 use chains::CellChains;
 use glam::DVec3;
@@ -167,6 +168,7 @@ impl Lists {
 
     /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
     /// every list keeps its order, so the `back` places hold.
+    #[cfg(feature = "experiments")]
     fn relabel(&mut self, perm: &[Label], inv: &[Label]) {
         apply_chunks(&mut self.flat, self.stride, perm);
         apply(&mut self.len, perm);
@@ -283,6 +285,7 @@ impl NeighbourLists {
 
     /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
     /// every list and cell keeps its order.
+    #[cfg(feature = "experiments")]
     pub fn relabel(&mut self, perm: &[Label], inv: &[Label]) {
         apply(&mut self.centre, perm);
         self.lists.relabel(perm, inv);
