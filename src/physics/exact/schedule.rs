@@ -259,9 +259,8 @@ mod tests {
     /// Typed fields cost nothing: the records are as small as the packed words were.
     #[test]
     fn the_event_and_its_slot_stay_12_and_20_bytes() {
-        assert_eq!(size_of::<Event>(), 12);
-        assert_eq!(size_of::<Slot>(), 20);
-        assert_eq!(size_of::<Queued>(), 1);
+        let sizes = [size_of::<Event>(), size_of::<Slot>(), size_of::<Queued>()];
+        assert_eq!(sizes, [12, 20, 1], "Event, Slot, Queued");
     }
 
     /// A broad-phase event reads back as it went in, and marks the slot.
