@@ -40,7 +40,7 @@ pub struct CellBlocks {
     pool: Vec<[u32; WORDS]>,
     free: u32,
     /// Spheres `BLOCK..count` of the cells holding more than `BLOCK`.
-    overflow: HashMap<usize, Vec<u32>>,
+    overflow: HashMap<u32, Vec<u32>>,
 }
 
 impl CellBlocks {
@@ -60,7 +60,7 @@ impl CellBlocks {
         let over: usize = self.overflow.values().map(|v| v.capacity() * 4 + 32).sum();
         self.slot.capacity() * 4
             + self.pool.len() * size_of::<[u32; WORDS]>()
-            + self.overflow.capacity() * (size_of::<(usize, Vec<u32>)>() + 1)
+            + self.overflow.capacity() * (size_of::<(u32, Vec<u32>)>() + 1)
             + over
     }
 
@@ -108,7 +108,7 @@ impl CellBlocks {
         if k < BLOCK {
             self.block_mut(c)[k] = j;
         } else {
-            let o = self.overflow.entry(c).or_default();
+            let o = self.overflow.entry(c as u32).or_default();
             if k - BLOCK == o.len() {
                 o.push(j);
             } else {
@@ -122,7 +122,7 @@ impl CellBlocks {
         if k < BLOCK {
             self.block(c)[k]
         } else {
-            self.overflow[&c][k - BLOCK]
+            self.overflow[&(c as u32)][k - BLOCK]
         }
     }
 
@@ -162,7 +162,10 @@ impl CellBlocks {
         if let Some(k) = b[..inline].iter().position(|&j| j == i) {
             return k;
         }
-        let more = self.overflow.get(&c).map_or(&[][..], Vec::as_slice);
+        let more = self
+            .overflow
+            .get(&(c as u32))
+            .map_or(&[][..], Vec::as_slice);
         let k = more.iter().position(|&j| j == i);
         debug_assert!(k.is_some(), "sphere {i} is not in cell {c}");
         BLOCK + k.unwrap_or(0)
@@ -186,9 +189,9 @@ impl CellBlocks {
             self.set(c, k, moved);
         }
         if last == BLOCK {
-            self.overflow.remove(&c);
+            self.overflow.remove(&(c as u32));
         } else if last > BLOCK
-            && let Some(o) = self.overflow.get_mut(&c)
+            && let Some(o) = self.overflow.get_mut(&(c as u32))
         {
             o.pop();
         }
@@ -284,7 +287,7 @@ impl CellBlocks {
         if counts as usize > BLOCK {
             out.truncate(n);
             for &o in offsets {
-                if let Some(more) = self.overflow.get(&(base + o)) {
+                if let Some(more) = self.overflow.get(&((base + o) as u32)) {
                     out.extend_from_slice(more);
                 }
             }
