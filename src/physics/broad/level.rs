@@ -21,7 +21,7 @@ pub(super) struct Ball {
 }
 
 /// A sphere in a level: its ball, id and padded cell key (on its way into
-/// the first level, `u32::MAX` when too wide for it). One record, so that
+/// the first level, [`WIDE`] when too wide for it). One record, so that
 /// sorting it into place writes one place in memory, not three.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Entry {
@@ -29,6 +29,9 @@ pub(super) struct Entry {
     pub(super) id: u32,
     pub(super) key: u32,
 }
+
+/// The key of a ball too wide for the level's cells: in no cell.
+pub(super) const WIDE: u32 = u32::MAX;
 
 /// A ball within reach of nothing (NaN compares false), padding the pair
 /// loops' candidate lists.
@@ -166,7 +169,7 @@ impl Level {
     }
 
     /// Sphere `id`'s record on its way into this level: its cell's key,
-    /// or `u32::MAX` and a place in `wide` when its ball is too wide.
+    /// or [`WIDE`] and a place in `wide` when its ball is too wide.
     #[inline(always)]
     pub(super) fn stage(
         &self,
@@ -179,7 +182,7 @@ impl Level {
             self.key_of(pos)
         } else {
             wide.push((ball, id));
-            u32::MAX
+            WIDE
         };
         Entry { ball, id, key }
     }

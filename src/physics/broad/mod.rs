@@ -11,7 +11,7 @@ mod level;
 use super::exec::{Exec, for_each_block_of, for_each_chunk};
 use super::sphere::Sphere;
 use glam::DVec3;
-use level::{Ball, Entry, Level, Source, within};
+use level::{Ball, Entry, Level, Source, WIDE, within};
 use parking_lot::Mutex;
 use std::cell::Cell;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -174,7 +174,7 @@ impl Grid {
                 let (mut count, mut reach_max) = (0, 0.0f64);
                 for ((slot, s), id) in self.staged.iter_mut().zip(spheres).zip(0..) {
                     *slot = level.stage(ball(s), id, &mut self.rest);
-                    if slot.key != u32::MAX {
+                    if slot.key != WIDE {
                         level.cell_start[slot.key as usize] += 1;
                         count += 1;
                         // Not `f64::max`: see `fill_lanes`.
@@ -277,7 +277,7 @@ impl Grid {
             for ((slot, s), id) in mine.zip(first..) {
                 let e = level.stage(ball(s), id, &mut wide);
                 // Not `f64::max`: see `fill_lanes`.
-                if e.key != u32::MAX && e.ball.reach > reach_max {
+                if e.key != WIDE && e.ball.reach > reach_max {
                     reach_max = e.ball.reach;
                 }
                 *slot = e.key;

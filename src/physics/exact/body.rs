@@ -4,10 +4,11 @@
 //! cache line, so checking a neighbour, and whether a prediction about it
 //! still holds, costs one line; radii and masses live in the small
 //! [`SpeciesTable`].
+use super::ids::{Label, SpeciesId};
 use super::species::{Species, SpeciesTable};
 use crate::physics::sphere::Sphere;
 use glam::DVec3;
-use std::ops::{Deref, DerefMut};
+use std::ops::{Deref, DerefMut, Index, IndexMut};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C, align(64))]
@@ -19,7 +20,7 @@ pub struct Body {
     /// Collisions so far (sphere or wall): a prediction naming this sphere
     /// as partner holds while its count is the one it saw.
     pub count: u32,
-    pub species: u32,
+    pub species: SpeciesId,
 }
 
 impl Body {
@@ -72,20 +73,20 @@ impl Bodies {
     }
 
     #[inline(always)]
-    pub fn radius(&self, i: usize) -> f64 {
-        self.radius_of(&self.list[i])
+    pub fn radius(&self, i: Label) -> f64 {
+        self.radius_of(&self[i])
     }
 
-    #[inline(always)]
-    pub fn mass(&self, i: usize) -> f64 {
-        self.species.get(self.list[i].species).mass
+    /// The labels of the bodies, in order.
+    pub fn labels(&self) -> impl Iterator<Item = Label> + use<> {
+        (0..self.list.len()).map(Label::at)
     }
 
     /// A [`Sphere`] view of body `i`, so the shared contact code applies
     /// unchanged.
     #[inline(always)]
-    pub fn sphere(&self, i: usize) -> Sphere {
-        let b = &self.list[i];
+    pub fn sphere(&self, i: Label) -> Sphere {
+        let b = &self[i];
         let Species { radius, mass } = self.species_of(b);
         Sphere {
             pos: b.pos,
@@ -96,6 +97,7 @@ impl Bodies {
     }
 
     /// The bodies, to be put in a new order.
+    #[cfg(feature = "experiments")]
     pub fn list_mut(&mut self) -> &mut Vec<Body> {
         &mut self.list
     }
@@ -116,6 +118,21 @@ impl Deref for Bodies {
 impl DerefMut for Bodies {
     fn deref_mut(&mut self) -> &mut [Body] {
         &mut self.list
+    }
+}
+
+impl Index<Label> for Bodies {
+    type Output = Body;
+    #[inline(always)]
+    fn index(&self, i: Label) -> &Body {
+        &self.list[i.index()]
+    }
+}
+
+impl IndexMut<Label> for Bodies {
+    #[inline(always)]
+    fn index_mut(&mut self, i: Label) -> &mut Body {
+        &mut self.list[i.index()]
     }
 }
 

@@ -15,8 +15,19 @@ use super::queue::{EventQueue, key, time};
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
-/// End of a list.
-const NIL: u32 = u32::MAX;
+/// An entry's place in `entries`: what the buckets' and the overflow's
+/// lists link.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct EntryId(u32);
+
+impl EntryId {
+    /// The end of a list.
+    const NONE: EntryId = EntryId(u32::MAX);
+
+    fn index(self) -> usize {
+        self.0 as usize
+    }
+}
 
 /// The calendar's window, in medians of the pending events' times ahead
 /// (taken at each rebuild): with one event per sphere, these are roughly
@@ -31,7 +42,7 @@ const SAMPLES: usize = 1024;
 struct Entry {
     key: u64,
     sphere: u32,
-    next: u32,
+    next: EntryId,
 }
 
 #[derive(Clone, Debug, Default)]
@@ -40,13 +51,13 @@ pub struct Calendar {
     keys: Vec<u64>,
     /// The entries of every list (buckets, overflow), and the free ones.
     entries: Vec<Entry>,
-    free: u32,
+    free: EntryId,
     /// First entry of each bucket; bucket `a` (an absolute number) is slot
     /// `a & (heads.len() - 1)` while it is in the window.
-    heads: Vec<u32>,
+    heads: Vec<EntryId>,
     /// Entries in buckets (live or dead): none means the window is empty.
     in_buckets: usize,
-    overflow: u32,
+    overflow: EntryId,
     /// The current bucket and every earlier one, ordered by key then sphere.
     heap: BinaryHeap<Reverse<(u64, u32)>>,
     /// Time of bucket 0's start and buckets a unit of time.
@@ -89,22 +100,22 @@ impl Calendar {
     }
 
     #[inline(always)]
-    fn alloc(&mut self, key: u64, sphere: u32, next: u32) -> u32 {
+    fn alloc(&mut self, key: u64, sphere: u32, next: EntryId) -> EntryId {
         let e = Entry { key, sphere, next };
-        if self.free == NIL {
+        if self.free == EntryId::NONE {
             self.entries.push(e);
-            (self.entries.len() - 1) as u32
+            EntryId((self.entries.len() - 1) as u32)
         } else {
             let k = self.free;
-            self.free = self.entries[k as usize].next;
-            self.entries[k as usize] = e;
+            self.free = self.entries[k.index()].next;
+            self.entries[k.index()] = e;
             k
         }
     }
 
     #[inline(always)]
-    fn release(&mut self, k: u32) {
-        self.entries[k as usize].next = self.free;
+    fn release(&mut self, k: EntryId) {
+        self.entries[k.index()].next = self.free;
         self.free = k;
     }
 
@@ -133,10 +144,10 @@ impl Calendar {
     /// Spread the overflow over the window from `cur`: drop dead entries,
     /// move the ones now inside to their bucket (or the heap).
     fn spill(&mut self) {
-        let mut k = std::mem::replace(&mut self.overflow, NIL);
+        let mut k = std::mem::replace(&mut self.overflow, EntryId::NONE);
         let end = self.cur.saturating_add(self.slots());
-        while k != NIL {
-            let Entry { key, sphere, next } = self.entries[k as usize];
+        while k != EntryId::NONE {
+            let Entry { key, sphere, next } = self.entries[k.index()];
             match self.bucket(key) {
                 Some(a) if self.live(key, sphere) => {
                     if a <= self.cur {
@@ -144,11 +155,11 @@ impl Calendar {
                         self.release(k);
                     } else if a < end {
                         let slot = (a as usize) & (self.heads.len() - 1);
-                        self.entries[k as usize].next = self.heads[slot];
+                        self.entries[k.index()].next = self.heads[slot];
                         self.heads[slot] = k;
                         self.in_buckets += 1;
                     } else {
-                        self.entries[k as usize].next = self.overflow;
+                        self.entries[k.index()].next = self.overflow;
                         self.overflow = k;
                     }
                 }
@@ -164,8 +175,8 @@ impl Calendar {
     fn jump(&mut self) -> bool {
         let mut earliest = None::<i64>;
         let mut k = self.overflow;
-        while k != NIL {
-            let e = self.entries[k as usize];
+        while k != EntryId::NONE {
+            let e = self.entries[k.index()];
             if self.live(e.key, e.sphere)
                 && let Some(a) = self.bucket(e.key)
             {
@@ -179,9 +190,9 @@ impl Calendar {
             return true;
         }
         // Only dead entries: free them all.
-        let mut k = std::mem::replace(&mut self.overflow, NIL);
-        while k != NIL {
-            let next = self.entries[k as usize].next;
+        let mut k = std::mem::replace(&mut self.overflow, EntryId::NONE);
+        while k != EntryId::NONE {
+            let next = self.entries[k.index()].next;
             self.release(k);
             k = next;
         }
@@ -195,9 +206,9 @@ impl Calendar {
             self.spill();
         }
         let slot = (self.cur as usize) & (self.heads.len() - 1);
-        let mut k = std::mem::replace(&mut self.heads[slot], NIL);
-        while k != NIL {
-            let Entry { key, sphere, next } = self.entries[k as usize];
+        let mut k = std::mem::replace(&mut self.heads[slot], EntryId::NONE);
+        while k != EntryId::NONE {
+            let Entry { key, sphere, next } = self.entries[k.index()];
             self.heap.push(Reverse((key, sphere)));
             self.release(k);
             self.in_buckets -= 1;
@@ -220,11 +231,12 @@ impl Calendar {
     fn clear(&mut self) {
         let n = self.keys.len();
         self.entries.clear();
-        self.free = NIL;
+        self.free = EntryId::NONE;
         self.heads.clear();
-        self.heads.resize(n.next_power_of_two().max(1), NIL);
+        self.heads
+            .resize(n.next_power_of_two().max(1), EntryId::NONE);
         self.in_buckets = 0;
-        self.overflow = NIL;
+        self.overflow = EntryId::NONE;
         self.heap.clear();
         self.idle = None;
         let finite = |k: &u64| time(*k).is_finite();

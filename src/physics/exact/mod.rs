@@ -5,23 +5,24 @@
 //! - lazy update: each sphere carries its own time stamp ([`body`]) and is
 //!   moved only when an event touches it or when `advance` returns;
 //! - one pending event per sphere (the earliest of contact, wall, or its
-//!   broad-phase event), in an [`EventQueue`] (a tournament tree, or the
-//!   bucket queue [`calendar`]);
+//!   broad-phase event), in an [`EventQueue`] (a tournament tree; the
+//!   bucket queue `calendar` is an experiment, feature `experiments`);
 //! - a broad phase chosen by packing fraction ([`LISTS_ABOVE_PACKING`]):
 //!   a cell grid with cell-crossing events for dilute and moderate scenes
 //!   ([`cell_grid`]), neighbour lists with a skin for dense ones
 //!   ([`neighbour_lists`]); both keep the few spheres far larger than the
 //!   bulk on a second level ([`large`]), so radii 100x apart stay cheap;
 //! - stale predictions detected by per-sphere collision counts ([`schedule`]);
-//! - spheres sorted in space at load, and on request relabelled again as
-//!   they drift ([`renumber`]); the world keeps every sphere at its id.
+//! - spheres sorted in space at load ([`spatial`]; relabelling them again
+//!   as they drift, `renumber`, is an experiment); the world keeps every
+//!   sphere at its id ([`ids`]: labels and world ids are apart).
 //!
 //! Time of impact comes from [`pair_toi`](crate::physics::contact::pair_toi)
 //! (stable quadratic, rounding guard: overlapping and approaching collides
 //! now, receding is left alone). Simultaneous events are processed in a
 //! fixed order: by the sphere whose prediction it is, in the model's
 //! internal order (sorted in space at load, and, if asked, again as the
-//! spheres drift, [`renumber`]: a pure function of the world and its history; a contact
+//! spheres drift, `renumber`: a pure function of the world and its history; a contact
 //! taken by either of its spheres is the same contact, bit for bit, and is
 //! reported lower world id first); a sphere's own candidates tie its broad-phase
 //! event (relist or crossing) first, then walls, then partners in the order
@@ -42,14 +43,20 @@
 //! (contacts in its remainder are missed, so overlaps may then appear), and
 //! the schedule is rebuilt for the next step.
 pub mod body;
+#[cfg(feature = "experiments")]
 pub mod calendar;
 pub mod cell_grid;
+#[cfg(feature = "experiments")]
+mod hooks;
+pub mod ids;
 pub mod large;
 pub mod neighbour_lists;
 mod overlap;
 pub mod queue;
+#[cfg(feature = "experiments")]
 pub mod renumber;
 pub mod schedule;
+pub mod spatial;
 pub mod species;
 
 use super::contact::{reflect_walls, resolve_pair};
@@ -58,12 +65,15 @@ use super::flight::fly;
 use super::model::{Model, ModelKind};
 use super::world::{Counters, World};
 use body::Bodies;
+#[cfg(feature = "experiments")]
 pub use calendar::Calendar;
 use cell_grid::CellGrid;
-use glam::DVec3;
+#[cfg(feature = "experiments")]
+pub use hooks::{Contact, Observer};
+use ids::{Label, WorldId};
 use neighbour_lists::NeighbourLists;
 pub use queue::{EventQueue, Tournament};
-use schedule::{Event, Kind, Predictor, Slot};
+use schedule::{Event, Kind, Predictor, Queued, Slot};
 
 /// Events (contacts, wall hits, relists, stale predictions) a step may take,
 /// at least; scenes add [`EVENT_CAP_PER_SPHERE`] per sphere.
@@ -72,8 +82,6 @@ pub const EVENT_CAP_PER_SPHERE: u64 = 100;
 /// Internal times are kept relative to an origin that moves with the frames,
 /// so lazy positions `x + v (t - t_i)` never subtract large times.
 const ORIGIN_SPAN: f64 = 1.0;
-/// "No sphere" / "no cell" in the broad phases' `u32` indices.
-pub const NONE: u32 = u32::MAX;
 
 /// Above this packing fraction the broad phase is neighbour lists (a
 /// sphere's free path is short, so it meets its skin's edge rarely and
@@ -96,28 +104,12 @@ impl Default for Broad {
     }
 }
 
-/// A sphere–sphere contact, for observers (pressure virial, collision maps).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Contact {
-    /// Absolute simulated time.
-    pub time: f64,
-    pub i: usize,
-    pub j: usize,
-    /// Centres at contact.
-    pub pos_i: DVec3,
-    pub pos_j: DVec3,
-    /// Momentum exchanged (magnitude of the impulse along the line of centres).
-    pub impulse: f64,
-}
-
-pub type Observer = Box<dyn FnMut(&Contact) + Send>;
-
 /// The model, with today's event queue. The tournament stays the default:
 /// the calendar measured slower at 10k spheres and at packing 0.1 and 0.4,
 /// faster only at 1M dilute (docs/benchmarks.md, "exact's event queue").
 pub type Exact = EventDriven<Tournament>;
 
-/// The model over an event queue `Q` ([`Tournament`] or [`Calendar`]; a
+/// The model over an event queue `Q` ([`Tournament`] or `Calendar`; a
 /// type parameter, so both run in one binary at no cost to either).
 #[derive(Default)]
 pub struct EventDriven<Q: EventQueue> {
@@ -125,14 +117,15 @@ pub struct EventDriven<Q: EventQueue> {
     /// World index of each body: bodies are kept in a spatial order (sorted
     /// by cell when loaded), so neighbours sit close in memory and a
     /// prediction touches few cache lines.
-    order: Vec<u32>,
+    order: Vec<WorldId>,
     /// Each sphere's event; in cell mode its best contact or wall event
     /// (absolute time), kept apart from its crossing so a crossing rescans
     /// only new cells, and which of the two the queue holds.
     slots: Vec<Slot>,
     queue: Q,
     broad: Broad,
-    /// Scratch for the candidates a prediction gathers.
+    /// Scratch for the candidates a prediction gathers: labels, as the
+    /// cell grid packs them ([`Label::raw`]).
     candidates: Vec<u32>,
     size: f64,
     /// Absolute time of internal time zero.
@@ -142,14 +135,8 @@ pub struct EventDriven<Q: EventQueue> {
     /// `World::generation` of the world they were last written to.
     synced_generation: u64,
     valid: bool,
-    cap: Option<u64>,
-    cells_per_sphere: Option<u32>,
-    /// Sort the spheres in space again as they drift (off by default: it
-    /// measured slower, see docs/benchmarks.md "exact at scale").
-    renumbering: bool,
-    /// Broad-phase events (crossings, relists) at the last spatial sort.
-    sorted_at: u64,
-    observer: Option<Observer>,
+    #[cfg(feature = "experiments")]
+    hooks: hooks::Hooks,
     /// Events processed since construction, by kind.
     pub stats: EventStats,
 }
@@ -165,40 +152,12 @@ pub struct EventStats {
     pub crossings: u64,
     /// Full rebuilds of the schedule (start, outside changes, capped steps).
     pub rebuilds: u64,
-    /// Spatial re-sorts of the spheres ([`renumber`]).
+    /// Spatial re-sorts of the spheres (`renumber`, feature `experiments`).
+    #[cfg(feature = "experiments")]
     pub renumberings: u64,
 }
 
 impl<Q: EventQueue> EventDriven<Q> {
-    /// Set the events a step may take (default: [`EVENT_CAP_BASE`] plus
-    /// [`EVENT_CAP_PER_SPHERE`] per sphere).
-    #[must_use]
-    pub fn with_event_cap(mut self, cap: u64) -> Self {
-        self.cap = Some(cap);
-        self
-    }
-
-    /// Set the most cells per sphere of the cell grid (default
-    /// [`cell_grid::CELLS_PER_SPHERE`]; at least 1), for comparing grids.
-    #[must_use]
-    pub fn with_cells_per_sphere(mut self, k: u32) -> Self {
-        self.cells_per_sphere = Some(k.max(1));
-        self
-    }
-
-    /// Sort the spheres by cell again as they drift (default: only at
-    /// load), for comparing the two.
-    #[must_use]
-    pub fn with_renumbering(mut self, on: bool) -> Self {
-        self.renumbering = on;
-        self
-    }
-
-    /// Call `f` for every sphere–sphere contact.
-    pub fn set_observer(&mut self, f: Option<Observer>) {
-        self.observer = f;
-    }
-
     /// Bytes the model holds on the heap (its copy of the spheres, the
     /// schedule and the broad phase; not the world's own spheres).
     pub fn heap_bytes(&self) -> usize {
@@ -207,7 +166,8 @@ impl<Q: EventQueue> EventDriven<Q> {
             Broad::Cells(cells) => cells.heap_bytes(),
         };
         self.bodies.heap_bytes()
-            + (self.order.capacity() + self.candidates.capacity()) * 4
+            + self.order.capacity() * size_of::<WorldId>()
+            + self.candidates.capacity() * size_of::<u32>()
             + self.slots.capacity() * size_of::<Slot>()
             + self.queue.heap_bytes()
             + broad
@@ -219,8 +179,21 @@ impl<Q: EventQueue> EventDriven<Q> {
     }
 
     fn event_cap(&self) -> u64 {
-        self.cap
-            .unwrap_or(EVENT_CAP_BASE + EVENT_CAP_PER_SPHERE * self.bodies.len() as u64)
+        #[cfg(feature = "experiments")]
+        if let Some(cap) = self.hooks.cap() {
+            return cap;
+        }
+        EVENT_CAP_BASE + EVENT_CAP_PER_SPHERE * self.bodies.len() as u64
+    }
+
+    /// The most cells per sphere of the cell grid.
+    // Without the experiments' knobs, the default alone.
+    #[cfg_attr(not(feature = "experiments"), expect(clippy::unused_self))]
+    fn cells_per_sphere(&self) -> u32 {
+        #[cfg(feature = "experiments")]
+        return self.hooks.cells_per_sphere();
+        #[cfg(not(feature = "experiments"))]
+        cell_grid::CELLS_PER_SPHERE
     }
 
     /// Whether our bodies are exactly what we last wrote into `world`.
@@ -230,7 +203,7 @@ impl<Q: EventQueue> EventDriven<Q> {
             && world.time == self.synced_time
             && world.spheres.len() == self.bodies.len()
             && self.order.iter().zip(self.bodies.iter()).all(|(&k, b)| {
-                let s = &world.spheres[k as usize];
+                let s = &world.spheres[k.index()];
                 let kind = self.bodies.species_of(b);
                 s.pos == b.pos && s.vel == b.vel && s.radius == kind.radius && s.mass == kind.mass
             })
@@ -241,10 +214,14 @@ impl<Q: EventQueue> EventDriven<Q> {
         self.origin = world.time;
         self.synced_time = world.time;
         self.synced_generation = world.generation();
-        self.order = renumber::spatial_order(world.spheres.iter().map(|s| s.pos), world.size);
+        let positions = world.spheres.iter().map(|s| s.pos);
+        self.order = spatial::spatial_order(positions, world.size, WorldId::at);
         self.bodies =
-            Bodies::from_spheres(self.order.iter().map(|&k| &world.spheres[k as usize]), 0.0);
-        self.sorted_at = self.stats.crossings + self.stats.relists;
+            Bodies::from_spheres(self.order.iter().map(|&k| &world.spheres[k.index()]), 0.0);
+        #[cfg(feature = "experiments")]
+        {
+            self.hooks.sorted_at = self.stats.crossings + self.stats.relists;
+        }
         self.reschedule_all();
     }
 
@@ -271,14 +248,13 @@ impl<Q: EventQueue> EventDriven<Q> {
             self.broad = Broad::Lists(nl);
         } else {
             let mut cells = Box::<CellGrid>::default();
-            let per_sphere = self.cells_per_sphere.unwrap_or(cell_grid::CELLS_PER_SPHERE);
-            cells.build(&self.bodies, self.size, per_sphere);
+            cells.build(&self.bodies, self.size, self.cells_per_sphere());
             self.broad = Broad::Cells(cells);
         }
         self.queue.reset(n);
-        for i in 0..n {
+        for i in self.bodies.labels() {
             let t = self.predict(i);
-            self.queue.set_leaf(i, t);
+            self.queue.set_leaf(i.index(), t);
         }
         self.queue.rebuild();
         self.valid = true;
@@ -286,7 +262,7 @@ impl<Q: EventQueue> EventDriven<Q> {
 
     /// Sphere `i`'s next event, into its slot; returns its absolute time.
     #[inline]
-    fn predict(&mut self, i: usize) -> f64 {
+    fn predict(&mut self, i: Label) -> f64 {
         let a = &self.bodies[i];
         match &self.broad {
             Broad::Lists(nl) => {
@@ -300,7 +276,7 @@ impl<Q: EventQueue> EventDriven<Q> {
                     p.pair(l.j);
                 }
                 let (t, ev) = p.finish();
-                self.slots[i] = Slot { t, ev };
+                self.slots[i.index()] = Slot { t, ev };
                 t
             }
             Broad::Cells(cells) => {
@@ -308,12 +284,12 @@ impl<Q: EventQueue> EventDriven<Q> {
                 let mut p = Predictor::new(a, &self.bodies, self.size, f64::INFINITY, idle);
                 let n = cells.candidates(i, p.radius(), &mut self.candidates);
                 for &j in &self.candidates[..n] {
-                    if j as usize != i {
-                        p.pair(j);
+                    if j != i.raw() {
+                        p.pair(Label::from_raw(j));
                     }
                 }
                 let (t, ev) = p.finish();
-                self.slots[i] = Slot { t, ev };
+                self.slots[i.index()] = Slot { t, ev };
                 self.with_crossing(i)
             }
         }
@@ -322,35 +298,34 @@ impl<Q: EventQueue> EventDriven<Q> {
     /// Cell mode: the earlier of the pending event and the next crossing
     /// (the crossing first on a tie), marked in the slot; returns its time.
     #[inline]
-    fn with_crossing(&mut self, i: usize) -> f64 {
+    fn with_crossing(&mut self, i: Label) -> f64 {
         let Broad::Cells(cells) = &self.broad else {
             unreachable!("crossings only in cell mode")
         };
         let a = &self.bodies[i];
         let (tc, ev) = cells.next_event(i, a);
         let tc = a.t + tc;
-        let slot = &mut self.slots[i];
+        let slot = &mut self.slots[i.index()];
         let tp = slot.t;
         // By index: which comes first is random, and a branch on it
         // mispredicted a third of the time.
-        let first = tc <= tp;
-        let broad = 8 | ev.mask | u8::from(ev.kind == Kind::Relist) << 4;
-        slot.ev.cross = [0, broad][usize::from(first)];
-        [tp, tc][usize::from(first)]
+        let first = usize::from(tc <= tp);
+        slot.ev.queued = [Queued::PENDING, Queued::broad(&ev)][first];
+        [tp, tc][first]
     }
 
     #[inline]
-    fn schedule(&mut self, i: usize) {
+    fn schedule(&mut self, i: Label) {
         let t = self.predict(i);
-        self.queue.update(i, t);
+        self.queue.update(i.index(), t);
     }
 
     /// Cell mode, after sphere `i` crossed as `mask` says: its pending event
     /// still holds unless its partner has moved on; only the new layer of
     /// cells needs checking.
-    fn after_crossing(&mut self, i: usize, mask: u8) {
-        let (tp, evp) = self.slots[i].pending();
-        if evp.kind == Kind::Pair && self.bodies[evp.partner as usize].count != evp.partner_count {
+    fn after_crossing(&mut self, i: Label, mask: u8) {
+        let (tp, evp) = self.slots[i.index()].pending();
+        if evp.kind == Kind::Pair && self.bodies[evp.partner].count != evp.partner_count {
             self.schedule(i);
             return;
         }
@@ -361,12 +336,12 @@ impl<Q: EventQueue> EventDriven<Q> {
         let mut p = Predictor::resume(a, &self.bodies, tp - a.t, evp);
         let n = cells.new_candidates(i, mask, &mut self.candidates);
         for &j in &self.candidates[..n] {
-            p.pair(j);
+            p.pair(Label::from_raw(j));
         }
         let (t, ev) = p.finish();
-        self.slots[i] = Slot { t, ev };
+        self.slots[i.index()] = Slot { t, ev };
         let t = self.with_crossing(i);
-        self.queue.update(i, t);
+        self.queue.update(i.index(), t);
     }
 
     /// Move the time origin to `world_time`: every body is moved to it first.
@@ -396,6 +371,7 @@ impl<Q: EventQueue> EventDriven<Q> {
         let mut done = 0u64;
         loop {
             let (t, i) = self.queue.peek();
+            let i = Label::at(i);
             if t.is_nan() || t > target {
                 return true;
             }
@@ -403,11 +379,11 @@ impl<Q: EventQueue> EventDriven<Q> {
                 return false;
             }
             done += 1;
-            let ev = self.slots[i].queued();
+            let ev = self.slots[i.index()].queued();
             self.bodies[i].advance(t);
             match ev.kind {
                 Kind::Pair => {
-                    let j = ev.partner as usize;
+                    let j = ev.partner;
                     if self.bodies[j].count != ev.partner_count {
                         self.stats.stale += 1;
                         self.schedule(i);
@@ -418,7 +394,7 @@ impl<Q: EventQueue> EventDriven<Q> {
                     self.collide(i, j, c);
                     let ti = self.predict(i);
                     let tj = self.predict(j);
-                    self.queue.update_two(i, ti, j, tj);
+                    self.queue.update_two(i.index(), ti, j.index(), tj);
                 }
                 Kind::Wall => {
                     self.stats.walls += 1;
@@ -463,29 +439,15 @@ impl<Q: EventQueue> EventDriven<Q> {
         }
     }
 
-    fn collide(&mut self, i: usize, j: usize, c: &mut Counters) {
+    fn collide(&mut self, i: Label, j: Label, c: &mut Counters) {
         let mut a = self.bodies.sphere(i);
         let mut b = self.bodies.sphere(j);
+        #[cfg(feature = "experiments")]
         let before = [a.vel, b.vel];
         if resolve_pair(&mut a, &mut b) {
             c.sphere_collisions += 1;
-            if let Some(f) = &mut self.observer {
-                // Lower world id first, whichever of the two predicted the
-                // contact (labels decide that on a tie; `resolve_pair` gives
-                // the same velocities either way round, bit for bit), so
-                // observers see the same contact whatever the labels.
-                let (ids, spheres) = ([self.order[i], self.order[j]], [&a, &b]);
-                let lo = usize::from(ids[1] < ids[0]);
-                let (p, q) = (spheres[lo], spheres[1 - lo]);
-                f(&Contact {
-                    time: self.origin + self.bodies[i].t,
-                    i: ids[lo] as usize,
-                    j: ids[1 - lo] as usize,
-                    pos_i: p.pos,
-                    pos_j: q.pos,
-                    impulse: p.mass * (p.vel - before[lo]).length(),
-                });
-            }
+            #[cfg(feature = "experiments")]
+            self.observe((i, j), [&a, &b], before);
         }
         for (k, v) in [(i, a.vel), (j, b.vel)] {
             let body = &mut self.bodies[k];
@@ -496,7 +458,7 @@ impl<Q: EventQueue> EventDriven<Q> {
 
     /// After a capped step: finish it by free flight with wall bounces.
     fn fly_all(&mut self, target: f64, c: &mut Counters) {
-        for i in 0..self.bodies.len() {
+        for i in self.bodies.labels() {
             let mut s = self.bodies.sphere(i);
             let (imp, hits) = fly(&mut s, self.size, target - self.bodies[i].t);
             c.wall_momentum += imp;
@@ -510,7 +472,7 @@ impl<Q: EventQueue> EventDriven<Q> {
         let now = world.time - self.origin;
         for (&k, b) in self.order.iter().zip(self.bodies.iter_mut()) {
             b.advance(now);
-            let s = &mut world.spheres[k as usize];
+            let s = &mut world.spheres[k.index()];
             s.pos = b.pos;
             s.vel = b.vel;
         }
@@ -537,15 +499,8 @@ impl<Q: EventQueue + Send> Model for EventDriven<Q> {
                 self.reorigin(world.time);
             }
             let target = end - self.origin;
-            // Once the spheres have crossed about a cell each, on average.
-            let moved = self.stats.crossings + self.stats.relists;
-            if self.valid
-                && self.renumbering
-                && moved - self.sorted_at >= self.bodies.len().max(1) as u64
-            {
-                self.renumber();
-                self.sorted_at = moved;
-            }
+            #[cfg(feature = "experiments")]
+            self.renumber_if_drifted();
             if !self.valid {
                 for b in self.bodies.iter_mut() {
                     b.advance(world.time - self.origin);

@@ -9,6 +9,7 @@
 //! neighbour lists, relists keep each sphere within the skin of its list
 //! centre, so two spheres that touch are listed.
 use super::body::Bodies;
+use super::ids::Label;
 use super::queue::EventQueue;
 use super::{Broad, EventDriven};
 use crate::physics::exec::{Exec, for_each_block};
@@ -34,12 +35,12 @@ impl<Q: EventQueue> EventDriven<Q> {
             Broad::Lists(nl) => {
                 let n = bodies.len();
                 for_each_block(exec, n.div_ceil(BLOCK), &|b| {
-                    let spheres = b * BLOCK..((b + 1) * BLOCK).min(n);
+                    let spheres = (b * BLOCK..((b + 1) * BLOCK).min(n)).map(Label::at);
                     keep(spheres.fold(0.0, |w: f64, i| {
                         nl.of(i)
                             .iter()
-                            .filter(|l| l.j as usize > i)
-                            .fold(w, |w, l| deeper(w, bodies, i, l.j as usize))
+                            .filter(|l| l.j > i)
+                            .fold(w, |w, l| deeper(w, bodies, i, l.j))
                     }));
                 });
             }
@@ -57,12 +58,11 @@ impl<Q: EventQueue> EventDriven<Q> {
                 // their scan, and each other.
                 let mut out = Vec::new();
                 for &i in cells.bigs() {
-                    let i = i as usize;
                     let k = cells.candidates(i, bodies.radius(i), &mut out);
                     keep(
                         out[..k]
                             .iter()
-                            .map(|&j| j as usize)
+                            .map(|&j| Label::from_raw(j))
                             .filter(|&j| !cells.is_big(j) || j > i)
                             .fold(0.0, |w, j| deeper(w, bodies, i, j)),
                     );
@@ -76,7 +76,7 @@ impl<Q: EventQueue> EventDriven<Q> {
 /// `worst`, or the overlap of bodies `i` and `j` relative to the smaller
 /// radius if deeper: the depth computed as `World::max_overlap_rel` does.
 #[inline]
-fn deeper(worst: f64, bodies: &Bodies, i: usize, j: usize) -> f64 {
+fn deeper(worst: f64, bodies: &Bodies, i: Label, j: Label) -> f64 {
     let (a, b) = (&bodies[i], &bodies[j]);
     let (ra, rb) = (bodies.radius_of(a), bodies.radius_of(b));
     let s = ra + rb;

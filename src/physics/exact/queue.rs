@@ -1,7 +1,7 @@
 //! The event queue: one pending event per sphere ([`EventQueue`]), and a
 //! tournament tree ([`Tournament`]: a complete binary tree whose every inner
 //! node holds the earlier of its two children); the bucket queue is
-//! [`super::calendar::Calendar`].
+//! `calendar::Calendar` (feature `experiments`).
 //! `DynamO` and Smallenburg's EDMD also keep one event per particle; the tree
 //! makes "replace sphere i's event" and "peek the earliest" O(log N) and
 //! O(1) with no allocation and no stale entries, which a binary heap of all

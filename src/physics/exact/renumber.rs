@@ -1,60 +1,33 @@
-//! Spatial renumbering: the event loop keeps its spheres in the order of
-//! their cells, so a sphere's neighbours sit close to it in every
-//! per-sphere array and a prediction touches few cache lines. The load
-//! sorts them; as they drift, [`EventDriven::renumber`] sorts them again
-//! (when asked: `with_renumbering(true)`; at 100k and 1M spheres it cost
-//! more than it saved, see docs/benchmarks.md "exact at scale").
+//! Spatial renumbering (feature `experiments`): the load sorts the spheres
+//! in space ([`super::spatial`]); as they drift, [`EventDriven::renumber`]
+//! sorts them again (when asked: `with_renumbering(true)`; at 100k and 1M
+//! spheres it cost more than it saved, see docs/benchmarks.md "exact at
+//! scale"). The pins of `tests/exact_pin.rs` run with it on, so they hold
+//! it to changing nothing.
 //! Only labels change: every record moves with its sphere and keeps its
 //! value (and each cell and list keeps its order), and `order` maps the
 //! labels back to the world's ids, so the world, the CSV and the screen
 //! see every sphere at its id.
 use super::body::Body;
+use super::ids::Label;
 use super::queue::EventQueue;
 use super::schedule::{Event, Kind};
+use super::spatial::spatial_order;
 use super::{Broad, EventDriven};
-use glam::DVec3;
-
-/// Sphere labels in the order of their cells on a grid of about one cell a
-/// sphere, z then y then x; ties keep their current order (a counting sort:
-/// linear, and stable). `perm[new] = old`.
-#[must_use]
-pub fn spatial_order(positions: impl ExactSizeIterator<Item = DVec3>, size: f64) -> Vec<u32> {
-    let n = positions.len();
-    let per_side = ((n as f64).cbrt().ceil() as usize).max(1);
-    let cell = |x: f64| ((x / size * per_side as f64) as usize).min(per_side - 1);
-    let key = |p: DVec3| {
-        cell(p.x.max(0.0)) + per_side * (cell(p.y.max(0.0)) + per_side * cell(p.z.max(0.0)))
-    };
-    let keys: Vec<u32> = positions.map(|p| key(p) as u32).collect();
-    let mut start = vec![0u32; per_side * per_side * per_side + 1];
-    for &k in &keys {
-        start[k as usize + 1] += 1;
-    }
-    for c in 1..start.len() {
-        start[c] += start[c - 1];
-    }
-    let mut perm = vec![0u32; n];
-    for (i, &k) in keys.iter().enumerate() {
-        let at = &mut start[k as usize];
-        perm[*at as usize] = i as u32;
-        *at += 1;
-    }
-    perm
-}
 
 /// The inverse of a permutation: `inv[old] = new`.
 #[must_use]
-pub fn inverse(perm: &[u32]) -> Vec<u32> {
-    let mut inv = vec![0u32; perm.len()];
+pub fn inverse(perm: &[Label]) -> Vec<Label> {
+    let mut inv = vec![Label::default(); perm.len()];
     for (new, &old) in perm.iter().enumerate() {
-        inv[old as usize] = new as u32;
+        inv[old.index()] = Label::at(new);
     }
     inv
 }
 
 /// Reorder `v` in place so that `v[new] = v_before[perm[new]]`, following
 /// the cycles of the permutation (no copy of `v`).
-pub fn apply<T: Copy>(v: &mut [T], perm: &[u32]) {
+pub fn apply<T: Copy>(v: &mut [T], perm: &[Label]) {
     let mut done = vec![false; perm.len()];
     for start in 0..perm.len() {
         if done[start] {
@@ -64,7 +37,7 @@ pub fn apply<T: Copy>(v: &mut [T], perm: &[u32]) {
         let mut at = start;
         loop {
             done[at] = true;
-            let from = perm[at] as usize;
+            let from = perm[at].index();
             if from == start {
                 v[at] = first;
                 break;
@@ -76,7 +49,7 @@ pub fn apply<T: Copy>(v: &mut [T], perm: &[u32]) {
 }
 
 /// [`apply`] to the records of `width` items each that `v` holds, one a sphere.
-pub fn apply_chunks<T: Copy + Default>(v: &mut [T], width: usize, perm: &[u32]) {
+pub fn apply_chunks<T: Copy + Default>(v: &mut [T], width: usize, perm: &[Label]) {
     let mut done = vec![false; perm.len()];
     let mut first = vec![T::default(); width];
     for start in 0..perm.len() {
@@ -87,7 +60,7 @@ pub fn apply_chunks<T: Copy + Default>(v: &mut [T], width: usize, perm: &[u32]) 
         let mut at = start;
         loop {
             done[at] = true;
-            let from = perm[at] as usize;
+            let from = perm[at].index();
             if from == start {
                 v[at * width..(at + 1) * width].copy_from_slice(&first);
                 break;
@@ -99,21 +72,38 @@ pub fn apply_chunks<T: Copy + Default>(v: &mut [T], width: usize, perm: &[u32]) 
 }
 
 /// A pair event names its partner by label: relabel it.
-fn relabel(ev: &mut Event, inv: &[u32]) {
+fn relabel(ev: &mut Event, inv: &[Label]) {
     if ev.kind == Kind::Pair {
-        ev.partner = inv[ev.partner as usize];
+        ev.partner = inv[ev.partner.index()];
     }
 }
 
 impl<Q: EventQueue> EventDriven<Q> {
+    /// Renumber, if on, once the spheres have crossed about a cell each on
+    /// average since the last sort.
+    pub(super) fn renumber_if_drifted(&mut self) {
+        let moved = self.stats.crossings + self.stats.relists;
+        if self.valid
+            && self.hooks.renumbering
+            && moved - self.hooks.sorted_at >= self.bodies.len().max(1) as u64
+        {
+            self.renumber();
+            self.hooks.sorted_at = moved;
+        }
+    }
+
     /// Sort the spheres by cell again (their positions at their own time
     /// stamps), moving every per-sphere record with its sphere.
     pub(super) fn renumber(&mut self) {
-        let perm = spatial_order(self.bodies.iter().map(|b: &Body| b.pos), self.size);
+        let perm = spatial_order(
+            self.bodies.iter().map(|b: &Body| b.pos),
+            self.size,
+            Label::at,
+        );
         let inv = inverse(&perm);
         let times: Vec<f64> = perm
             .iter()
-            .map(|&old| self.queue.time_of(old as usize))
+            .map(|&old| self.queue.time_of(old.index()))
             .collect();
         apply(self.bodies.list_mut(), &perm);
         apply(&mut self.order, &perm);
@@ -142,35 +132,18 @@ mod tests {
 
     #[test]
     fn apply_moves_each_record_to_its_new_label() {
-        let perm = [3u32, 0, 4, 1, 2, 6, 5];
+        let raw = [3u32, 0, 4, 1, 2, 6, 5];
+        let perm = raw.map(Label::from_raw);
         let mut v: Vec<u32> = (100..107).collect();
         apply(&mut v, &perm);
-        assert_eq!(v, perm.map(|o| 100 + o));
+        assert_eq!(v, raw.map(|o| 100 + o));
         let mut w: Vec<u32> = (0..14).collect();
         apply_chunks(&mut w, 2, &perm);
-        let want: Vec<u32> = perm.iter().flat_map(|&o| [2 * o, 2 * o + 1]).collect();
+        let want: Vec<u32> = raw.iter().flat_map(|&o| [2 * o, 2 * o + 1]).collect();
         assert_eq!(w, want);
         let inv = inverse(&perm);
         for (new, &old) in perm.iter().enumerate() {
-            assert_eq!(inv[old as usize], new as u32);
+            assert_eq!(inv[old.index()], Label::at(new));
         }
-    }
-
-    #[test]
-    fn spatial_order_sorts_by_cell_and_keeps_ties_in_order() {
-        // Two per cell of a 2-a-side grid, given in reverse cell order.
-        let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
-        let pos = [
-            p(0.9, 0.9, 0.9),
-            p(0.1, 0.1, 0.1),
-            p(0.6, 0.1, 0.1),
-            p(0.2, 0.2, 0.2),
-            p(0.1, 0.1, 0.9),
-            p(0.1, 0.9, 0.1),
-            p(0.7, 0.7, 0.7),
-            p(0.3, 0.3, 0.3),
-        ];
-        let perm = spatial_order(pos.into_iter(), 1.0);
-        assert_eq!(perm, [1, 3, 7, 2, 5, 4, 0, 6]);
     }
 }

@@ -5,6 +5,7 @@
 //! stays valid while the partner's collision count is unchanged, and is
 //! recomputed when it comes due otherwise.
 use super::body::{Bodies, Body};
+use super::ids::Label;
 use crate::physics::contact::pair_toi;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -24,23 +25,63 @@ pub enum Kind {
     Cross,
 }
 
+/// A sphere's predicted event, 12 bytes.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Event {
     pub kind: Kind,
+    /// The walls' axes of a [`Kind::Wall`], the direction of a [`Kind::Cross`].
     pub mask: u8,
-    /// In a [`Slot`] in cell mode: 0 when the queue holds this event,
-    /// else the broad-phase event it holds (it came first): `8 | mask` of a
-    /// crossing, or 24 for a large sphere's rescan. It fills what was padding.
-    pub cross: u8,
-    pub partner: u32,
+    /// In a [`Slot`] in cell mode: which of two events the queue holds
+    /// (it fills what was padding).
+    pub queued: Queued,
+    /// The other sphere of a [`Kind::Pair`].
+    pub partner: Label,
     pub partner_count: u32,
+}
+
+/// Which event the queue holds for a sphere in cell mode: its pending
+/// event ([`Queued::PENDING`]), or the broad-phase event that came first
+/// (a crossing, with its direction, or a large sphere's rescan), which the
+/// grid tells cheaply, so only its kind and mask are kept. One byte: the
+/// mask in bits 0..3, bit 3 set for any broad-phase event, bit 4 for a rescan.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Queued(u8);
+
+impl Queued {
+    /// The queue holds the pending event itself.
+    pub const PENDING: Queued = Queued(0);
+    const BROAD: u8 = 8;
+    const RESCAN_BIT: u8 = 4;
+    const RESCAN: u8 = 1 << Self::RESCAN_BIT;
+    const MASK: u8 = 7;
+
+    /// The queue holds `ev`, a crossing or a large sphere's rescan ([`Kind::Relist`]).
+    #[inline(always)]
+    pub fn broad(ev: &Event) -> Queued {
+        Queued(Self::BROAD | ev.mask | u8::from(ev.kind == Kind::Relist) << Self::RESCAN_BIT)
+    }
+
+    /// Whether the queue holds a broad-phase event, not the pending one.
+    #[inline(always)]
+    pub fn is_broad(self) -> bool {
+        self != Self::PENDING
+    }
+
+    /// The broad-phase event held (meaningful when [`Self::is_broad`]).
+    #[inline(always)]
+    pub fn event(self) -> Event {
+        Event {
+            kind: [Kind::Cross, Kind::Relist][usize::from(self.0 & Self::RESCAN != 0)],
+            mask: self.0 & Self::MASK,
+            ..Event::default()
+        }
+    }
 }
 
 /// What the loop keeps of a sphere's prediction, 20 bytes: its best event
 /// other than a crossing and that event's absolute time (cell mode; lists
 /// keep the time in the queue alone), and whether the next crossing comes
-/// first. A crossing is cheap to tell from the grid, so only its direction
-/// is kept.
+/// first ([`Event::queued`]).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, packed(4))]
 pub struct Slot {
@@ -62,13 +103,8 @@ impl Slot {
     #[inline]
     pub fn queued(self) -> Event {
         let ev = self.ev;
-        let crossing = Event {
-            kind: [Kind::Cross, Kind::Relist][usize::from(ev.cross & 16 != 0)],
-            mask: ev.cross & 7,
-            ..Event::default()
-        };
         // By index: which of the two it is is random (see `with_crossing`).
-        [ev, crossing][usize::from(ev.cross != 0)]
+        [ev, ev.queued.event()][usize::from(ev.queued.is_broad())]
     }
 
     /// The pending event itself (not the crossing).
@@ -77,7 +113,7 @@ impl Slot {
         (
             self.t,
             Event {
-                cross: 0,
+                queued: Queued::PENDING,
                 ..self.ev
             },
         )
@@ -151,9 +187,9 @@ impl<'a> Predictor<'a> {
 
     /// Consider a contact with sphere `j`.
     #[inline(always)]
-    pub fn pair(&mut self, j: u32) {
+    pub fn pair(&mut self, j: Label) {
         let a = &self.a;
-        let b = &self.bodies[j as usize];
+        let b = &self.bodies[j];
         let dp = a.pos - b.pos_at(a.t);
         let dv = a.vel - b.vel;
         let bb = dp.dot(dv);
@@ -214,4 +250,32 @@ pub fn wall_toi(a: &Body, radius: f64, size: f64) -> (f64, u8) {
     let tmin = t[0].min(t[1]).min(t[2]);
     let mask = (t[0] == tmin) as u8 | ((t[1] == tmin) as u8) << 1 | ((t[2] == tmin) as u8) << 2;
     (tmin, mask)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Typed fields cost nothing: the records are as small as the packed words were.
+    #[test]
+    fn the_event_and_its_slot_stay_12_and_20_bytes() {
+        let sizes = [size_of::<Event>(), size_of::<Slot>(), size_of::<Queued>()];
+        assert_eq!(sizes, [12, 20, 1], "Event, Slot, Queued");
+    }
+
+    /// A broad-phase event reads back as it went in, and marks the slot.
+    #[test]
+    fn a_queued_broad_event_reads_back() {
+        assert!(!Queued::PENDING.is_broad());
+        for (kind, mask) in [(Kind::Cross, 0), (Kind::Cross, 6), (Kind::Relist, 0)] {
+            let ev = Event {
+                kind,
+                mask,
+                ..Event::default()
+            };
+            let q = Queued::broad(&ev);
+            assert!(q.is_broad());
+            assert_eq!((q.event().kind, q.event().mask), (kind, mask));
+        }
+    }
 }

@@ -4,6 +4,7 @@
 //! where every sphere differs keeps a table as long as the spheres (16 B a
 //! sphere, as a radius in the body and a mass array did). Either way a
 //! radius and a mass read back bit for bit.
+use super::ids::SpeciesId;
 use std::collections::HashMap;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -15,15 +16,15 @@ pub struct Species {
 #[derive(Clone, Debug, Default)]
 pub struct SpeciesTable {
     list: Vec<Species>,
-    known: HashMap<(u64, u64), u32>,
+    known: HashMap<(u64, u64), SpeciesId>,
     /// The last species named: runs of one species (most scenes) cost a
     /// compare, not a lookup.
-    last: Option<((u64, u64), u32)>,
+    last: Option<((u64, u64), SpeciesId)>,
 }
 
 impl SpeciesTable {
     /// The species of a sphere of this radius and mass, added if new.
-    pub fn name(&mut self, radius: f64, mass: f64) -> u32 {
+    pub fn name(&mut self, radius: f64, mass: f64) -> SpeciesId {
         let bits = (radius.to_bits(), mass.to_bits());
         if let Some((b, k)) = self.last
             && b == bits
@@ -31,7 +32,7 @@ impl SpeciesTable {
             return k;
         }
         // At most one species a sphere, and a world holds at most 10^7.
-        let next = self.list.len() as u32;
+        let next = SpeciesId::at(self.list.len());
         let k = *self.known.entry(bits).or_insert(next);
         if k == next {
             self.list.push(Species { radius, mass });
@@ -48,8 +49,8 @@ impl SpeciesTable {
     }
 
     #[inline(always)]
-    pub fn get(&self, k: u32) -> Species {
-        self.list[k as usize]
+    pub fn get(&self, k: SpeciesId) -> Species {
+        self.list[k.index()]
     }
 
     pub fn len(&self) -> usize {
@@ -63,7 +64,7 @@ impl SpeciesTable {
     /// Bytes held on the heap.
     pub fn heap_bytes(&self) -> usize {
         self.list.capacity() * size_of::<Species>()
-            + self.known.capacity() * (size_of::<((u64, u64), u32)>() + 1)
+            + self.known.capacity() * (size_of::<((u64, u64), SpeciesId)>() + 1)
     }
 }
 
@@ -75,7 +76,7 @@ mod tests {
     fn each_radius_and_mass_pair_is_named_once_and_reads_back_exactly() {
         let pairs = [(1.0, 2.0), (1.0, -0.0), (1.0, 0.0), (2.5e-7, 2.0)];
         let mut t = SpeciesTable::default();
-        let names: Vec<u32> = (0..1000)
+        let names: Vec<SpeciesId> = (0..1000)
             .map(|i| {
                 let (r, m) = pairs[i % 7 % 4];
                 t.name(r, m)
@@ -97,8 +98,8 @@ mod tests {
     #[test]
     fn a_scene_of_all_different_spheres_keeps_one_species_each() {
         let mut t = SpeciesTable::default();
-        let names: Vec<u32> = (0..5000).map(|i| t.name(1.0 + f64::from(i), 2.0)).collect();
-        assert_eq!(names, (0..5000).collect::<Vec<u32>>());
-        assert_eq!(t.get(4999).radius, 5000.0);
+        let names: Vec<SpeciesId> = (0..5000).map(|i| t.name(1.0 + f64::from(i), 2.0)).collect();
+        assert_eq!(names, (0..5000).map(SpeciesId::at).collect::<Vec<_>>());
+        assert_eq!(t.get(SpeciesId::at(4999)).radius, 5000.0);
     }
 }

@@ -8,7 +8,7 @@
 //! paths once both runs are done (see `rounds`). Each member's path is kept
 //! as the turns it took.
 use super::partition::Slot;
-use super::{NONE, REACH_SLACK, path_ball};
+use super::{REACH_SLACK, path_ball};
 use crate::physics::broad::Grid;
 use crate::physics::contact::{pair_toi, reflect_walls, resolve_pair, wall_toi};
 use crate::physics::flight::fly;
@@ -91,7 +91,10 @@ impl Local {
     }
 }
 
-/// An event; `a`, `b` are sphere ids (`b` NONE for a wall), `la`, `lb` the
+/// `Event::b` of a wall event: no sphere.
+const WALL: u32 = u32::MAX;
+
+/// An event; `a`, `b` are sphere ids (`b` [`WALL`] for a wall), `la`, `lb` the
 /// run's local indices, `ca`, `cb` the collision counts it was predicted at.
 #[derive(Clone, Copy, Debug)]
 struct Event {
@@ -256,7 +259,7 @@ impl Run {
         let mut done = 0usize;
         while let Some(e) = self.heap.pop() {
             let (la, lb) = (e.la.index(), e.lb.index());
-            if self.count[la] != e.ca || (e.b != NONE && self.count[lb] != e.cb) {
+            if self.count[la] != e.ca || (e.b != WALL && self.count[lb] != e.cb) {
                 continue;
             }
             done += 1;
@@ -271,7 +274,7 @@ impl Run {
             }
             self.advance_to(la, e.t);
             self.count[la] += 1;
-            if e.b == NONE {
+            if e.b == WALL {
                 let (_, mask) = wall_toi(&self.sp[la], sh.size);
                 let (imp, hits) = reflect_walls(&mut self.sp[la], mask);
                 self.wall_momentum[la] += imp;
@@ -622,7 +625,7 @@ fn push_wall(
         heap.push(Event {
             t: t + tw,
             a,
-            b: NONE,
+            b: WALL,
             la,
             lb: Local::NONE,
             ca,

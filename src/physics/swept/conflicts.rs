@@ -19,12 +19,11 @@ const LANES_MIN_BALLS: usize = 2048;
 /// By slot, what the cluster's last finished run left.
 #[derive(Default)]
 pub(super) struct Finished {
-    /// Where the member's record is: (chunk, index in it), `NO_RECORD`
-    /// until its cluster ran.
-    at: Vec<(u32, u32)>,
+    /// Where the member's record is, [`RecordAt::NONE`] until its cluster ran.
+    at: Vec<RecordAt>,
     /// Whether (and why) that run was capped.
     pub capped: Vec<Option<Coarse>>,
-    /// The round that run was made in (NONE before any).
+    /// The round that run was made in ([`NOT_RUN`] before any).
     pub ran: Vec<u32>,
     /// Whether the member's ball grew past the one the grid holds for it.
     grew: Vec<bool>,
@@ -34,16 +33,32 @@ pub(super) struct Finished {
     chunks: Vec<Chunk>,
 }
 
-const NO_RECORD: (u32, u32) = (u32::MAX, u32::MAX);
+/// Where a member's record is: its chunk, and its index in it.
+#[derive(Clone, Copy)]
+struct RecordAt {
+    chunk: u32,
+    member: u32,
+}
+
+impl RecordAt {
+    /// No record: no chunk has this number.
+    const NONE: RecordAt = RecordAt {
+        chunk: u32::MAX,
+        member: u32::MAX,
+    };
+}
+
+/// `Finished::ran` of a slot whose cluster has not run.
+const NOT_RUN: u32 = u32::MAX;
 
 impl Finished {
     pub fn reset(&mut self, m: usize) {
         self.at.clear();
-        self.at.resize(m, NO_RECORD);
+        self.at.resize(m, RecordAt::NONE);
         self.capped.clear();
         self.capped.resize(m, None);
         self.ran.clear();
-        self.ran.resize(m, super::NONE);
+        self.ran.resize(m, NOT_RUN);
         self.grew.clear();
         self.grew.resize(m, false);
         self.chunks.clear();
@@ -52,16 +67,16 @@ impl Finished {
     /// Drops every record: all the slots are about to run again as one
     /// cluster, so none is read again, and its memory is free for theirs.
     pub fn forget(&mut self) {
-        self.at.fill(NO_RECORD);
+        self.at.fill(RecordAt::NONE);
         self.grew.fill(false);
         self.chunks.clear();
     }
 
     /// Room for a slot added after the first round.
     pub fn push(&mut self) {
-        self.at.push(NO_RECORD);
+        self.at.push(RecordAt::NONE);
         self.capped.push(None);
-        self.ran.push(super::NONE);
+        self.ran.push(NOT_RUN);
         self.grew.push(false);
     }
 
@@ -76,14 +91,17 @@ impl Finished {
 
     /// Slot `s` finished as member `k` of chunk `c`.
     pub fn set(&mut self, s: usize, c: u32, k: usize) {
-        self.at[s] = (c, k as u32);
+        self.at[s] = RecordAt {
+            chunk: c,
+            member: k as u32,
+        };
         self.grew[s] = self.record_in(c, k).is_some_and(|(m, _)| m.grew);
     }
 
     /// Slot `s`'s record and its turns, if its cluster ran.
     pub fn record(&self, s: usize) -> Option<(&Member, &[Turn])> {
-        let (c, k) = self.at[s];
-        self.record_in(c, k as usize)
+        let RecordAt { chunk, member } = self.at[s];
+        self.record_in(chunk, member as usize)
     }
 
     /// Member `k` of chunk `c` and its turns.

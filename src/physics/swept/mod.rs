@@ -21,6 +21,8 @@
 mod cluster;
 mod conflicts;
 mod group;
+#[cfg(feature = "experiments")]
+mod knobs;
 mod partition;
 mod parts;
 mod rounds;
@@ -40,7 +42,6 @@ pub use parts::{ADDED_PAIRS, parts};
 pub use rounds::RoundStats;
 use rounds::Rounds;
 
-const NONE: u32 = u32::MAX;
 /// Reach balls are widened by this much so touching spheres, whose distance
 /// rounds either way, are always seen.
 const REACH_SLACK: f64 = 1.0 + 1e-9;
@@ -66,16 +67,14 @@ pub struct Swept {
     /// Per block of candidate pairs: the deepest overlap among them.
     overlap: Vec<Mutex<f64>>,
     rounds: Rounds,
-    /// Parts per step when not the scene's choice.
-    fixed_parts: Option<u32>,
     /// The last step's `rounds` stats, over all its parts.
     step_stats: RoundStats,
     /// Parts the last step was cut into.
     last_parts: u32,
     /// Detection already made for the next step of the world it names.
     ahead: Option<Ahead>,
-    /// The work budget per step, when not the default one: (base, per sphere).
-    budget: Option<(u64, u64)>,
+    #[cfg(feature = "experiments")]
+    knobs: knobs::Knobs,
 }
 
 /// A detection made ahead of its step (when the engine asked for the
@@ -204,40 +203,26 @@ impl Swept {
         self.step_stats
     }
 
-    /// Cut every step into `k` parts instead of the number the scene
-    /// calls for (see `parts.rs`); `None` goes back to that.
-    #[must_use]
-    pub fn fixed_parts(mut self, k: Option<u32>) -> Self {
-        self.fixed_parts = k.map(|k| k.clamp(1, parts::MAX_PARTS));
-        self
-    }
-
     /// The parts a step of `dt` from `world` is cut into.
+    // Without the experiments' knobs, the default alone.
+    #[cfg_attr(not(feature = "experiments"), expect(clippy::unused_self))]
     fn parts_of(&self, world: &World, dt: f64) -> u32 {
-        self.fixed_parts
-            .unwrap_or_else(|| parts::parts(&world.spheres, world.size, dt))
-    }
-
-    /// Run every step's events as one serial loop, not in clusters (the
-    /// reference the clusters must match).
-    #[must_use]
-    pub fn serial_events(mut self, on: bool) -> Self {
-        self.rounds.serial_only = on;
-        self
+        #[cfg(feature = "experiments")]
+        if let Some(k) = self.knobs.fixed_parts {
+            return k;
+        }
+        parts::parts(&world.spheres, world.size, dt)
     }
 
     /// The work budget for a step of `n` spheres.
+    // Without the experiments' knobs, the default alone.
+    #[cfg_attr(not(feature = "experiments"), expect(clippy::unused_self))]
     fn budget_of(&self, n: usize) -> u64 {
-        let (base, per) = self.budget.unwrap_or((BUDGET_BASE, BUDGET_PER_SPHERE));
+        #[cfg(feature = "experiments")]
+        let (base, per) = (self.knobs.budget).unwrap_or((BUDGET_BASE, BUDGET_PER_SPHERE));
+        #[cfg(not(feature = "experiments"))]
+        let (base, per) = (BUDGET_BASE, BUDGET_PER_SPHERE);
         base.saturating_add(per.saturating_mul(n as u64))
-    }
-
-    /// Give every step a work budget of `base + per_sphere × n` pair
-    /// checks instead of the default (`u64::MAX` for none).
-    #[must_use]
-    pub fn with_work_budget(mut self, base: u64, per_sphere: u64) -> Self {
-        self.budget = Some((base, per_sphere));
-        self
     }
 
     /// One part of a step (see `parts.rs`), with `left` work of the step's

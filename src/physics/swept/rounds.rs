@@ -111,6 +111,7 @@ pub(super) struct Rounds {
     pub work: u64,
     /// Run every step as one absorbing cluster (the plain serial loop),
     /// whatever the lanes.
+    #[cfg(feature = "experiments")]
     pub serial_only: bool,
 }
 
@@ -252,7 +253,11 @@ impl Rounds {
             involved: m,
             ..RoundStats::default()
         };
-        let serial = self.serial_only || PERCOLATION.1 * m > PERCOLATION.0 * n;
+        #[cfg(feature = "experiments")]
+        let forced = self.serial_only;
+        #[cfg(not(feature = "experiments"))]
+        let forced = false;
+        let serial = forced || PERCOLATION.1 * m > PERCOLATION.0 * n;
         if serial {
             self.part.no_partners();
             self.part.merge_all();

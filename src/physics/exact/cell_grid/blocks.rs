@@ -11,6 +11,7 @@
 //! written and counted by its flag, then a block is copied: the shared
 //! empty one unless the cell has its own). The rare spheres beyond
 //! [`BLOCK`] in one cell wait in a map from the cell.
+use crate::physics::exact::ids::Label;
 use std::collections::HashMap;
 
 /// Spheres a cell's block holds (cells are about a diameter wide, so most
@@ -25,7 +26,8 @@ const SCRATCH: usize = WINDOW + WORDS;
 const EMPTY: u32 = 0;
 /// Flag of a slot holding a lone sphere (the rest of the word).
 const ONE: u32 = 1 << 31;
-/// End of the free list.
+/// End of the free list (a block's number, as `slot` and a free block's
+/// first word keep it).
 const NO_BLOCK: u32 = u32::MAX;
 
 #[derive(Clone, Debug, Default)]
@@ -126,10 +128,11 @@ impl CellBlocks {
 
     /// Put sphere `i` last in cell `c`.
     #[inline]
-    pub fn insert(&mut self, i: usize, c: usize) {
+    pub fn insert(&mut self, i: Label, c: usize) {
         let s = self.slot[c];
+        let i = i.raw();
         if s == EMPTY {
-            self.slot[c] = ONE | i as u32;
+            self.slot[c] = ONE | i;
         } else if s & ONE != 0 {
             let b = if self.free == NO_BLOCK {
                 self.pool.push([0; WORDS]);
@@ -140,12 +143,12 @@ impl CellBlocks {
                 b
             };
             let mut block = [0; WORDS];
-            (block[0], block[1], block[BLOCK]) = (s & !ONE, i as u32, 2);
+            (block[0], block[1], block[BLOCK]) = (s & !ONE, i, 2);
             self.pool[b] = block;
             self.slot[c] = b as u32;
         } else {
             let k = self.block(c)[BLOCK] as usize;
-            self.set(c, k, i as u32);
+            self.set(c, k, i);
             self.block_mut(c)[BLOCK] += 1;
         }
     }
@@ -153,9 +156,8 @@ impl CellBlocks {
     /// Sphere `i`'s place in cell `c`, a cell with a block (it holds a few;
     /// the rare crowded one is searched past its block).
     #[inline]
-    fn place(&self, i: usize, c: usize) -> usize {
+    fn place(&self, i: u32, c: usize) -> usize {
         let b = self.block(c);
-        let i = i as u32;
         let inline = (b[BLOCK] as usize).min(BLOCK);
         if let Some(k) = b[..inline].iter().position(|&j| j == i) {
             return k;
@@ -172,10 +174,11 @@ impl CellBlocks {
     /// Take sphere `i` out of cell `c`, its cell; the cell's last sphere
     /// fills its place (so every cell keeps the order it had).
     #[inline]
-    pub fn remove(&mut self, i: usize, c: usize) {
+    pub fn remove(&mut self, i: Label, c: usize) {
         let s = self.slot[c];
+        let i = i.raw();
         if s & ONE != 0 {
-            debug_assert_eq!(s & !ONE, i as u32, "cell {c}");
+            debug_assert_eq!(s & !ONE, i, "cell {c}");
             self.slot[c] = EMPTY;
             return;
         }
@@ -205,11 +208,13 @@ impl CellBlocks {
 
     /// The spheres are relabelled (`inv[old] = new`); every cell keeps its
     /// order.
-    pub fn relabel(&mut self, inv: &[u32]) {
+    #[cfg(feature = "experiments")]
+    pub fn relabel(&mut self, inv: &[Label]) {
+        let new = |j: u32| inv[j as usize].raw();
         for c in 0..self.slot.len() {
             let s = self.slot[c];
             if s & ONE != 0 {
-                self.slot[c] = ONE | inv[(s & !ONE) as usize];
+                self.slot[c] = ONE | new(s & !ONE);
                 continue;
             }
             if s == EMPTY {
@@ -218,19 +223,19 @@ impl CellBlocks {
             let b = self.block_mut(c);
             let inline = (b[BLOCK] as usize).min(BLOCK);
             for j in &mut b[..inline] {
-                *j = inv[*j as usize];
+                *j = new(*j);
             }
         }
         for o in self.overflow.values_mut() {
             for j in o {
-                *j = inv[*j as usize];
+                *j = new(*j);
             }
         }
     }
 
     /// Move sphere `i` from cell `from` to the end of cell `to`.
     #[inline]
-    pub fn move_to(&mut self, i: usize, from: usize, to: usize) {
+    pub fn move_to(&mut self, i: Label, from: usize, to: usize) {
         self.remove(i, from);
         self.insert(i, to);
     }
@@ -365,15 +370,15 @@ mod tests {
             let here = reference.iter().position(|l| l.contains(&(i as u32)));
             let removed = match (here, rng.random_range(0..4)) {
                 (None, _) => {
-                    s.insert(i, to);
+                    s.insert(Label::at(i), to);
                     false
                 }
                 (Some(c), 0) => {
-                    s.remove(i, c);
+                    s.remove(Label::at(i), c);
                     true
                 }
                 (Some(c), _) => {
-                    s.move_to(i, c, to);
+                    s.move_to(Label::at(i), c, to);
                     false
                 }
             };
@@ -424,14 +429,14 @@ mod tests {
             // Crowd the low cells, so some hold more than BLOCK.
             let crowd = rng.random_range(1..=cells);
             *a = rng.random_range(0..crowd);
-            s.insert(i, *a);
+            s.insert(Label::at(i), *a);
         }
         let (mut a, mut b) = (Vec::new(), Vec::new());
         let mut overflowed = 0;
         for _ in 0..2000 {
             let i = rng.random_range(0..spheres);
             let to = rng.random_range(0..cells);
-            s.move_to(i, at[i], to);
+            s.move_to(Label::at(i), at[i], to);
             at[i] = to;
             let base = rng.random_range(0..cells - 30);
             let o27: [usize; 27] = std::array::from_fn(|_| rng.random_range(0..30));

@@ -14,7 +14,9 @@
 pub mod blocks;
 
 use super::body::{Bodies, Body};
+use super::ids::Label;
 use super::large::{BIG_FACTOR, split_big, time_to_leave};
+#[cfg(feature = "experiments")]
 use super::renumber::apply;
 use super::schedule::{Event, Kind};
 use blocks::CellBlocks;
@@ -73,7 +75,7 @@ pub struct CellGrid {
     /// The small spheres of each cell; large ones are in no cell.
     list: CellBlocks,
     /// The large spheres, in increasing order (found by bisection).
-    bigs: Vec<u32>,
+    bigs: Vec<Label>,
     /// Where each large sphere last scanned from (indexed like `bigs`).
     scan_centre: Vec<DVec3>,
     small_rmax: f64,
@@ -108,13 +110,13 @@ impl CellGrid {
         self.skin = self.cell;
         self.set_stencils();
         self.list.reset(n, self.padded.pow(3));
-        for (i, b) in bodies.iter().enumerate() {
+        for (i, b) in bodies.labels().zip(bodies.iter()) {
             if bodies.radius_of(b) > big_above {
-                self.bigs.push(i as u32);
+                self.bigs.push(i);
                 self.scan_centre.push(b.pos);
             } else {
                 let c = self.coords(b.pos);
-                self.place[i] = pack(c);
+                self.place[i.index()] = pack(c);
                 self.list.insert(i, self.index(c));
             }
         }
@@ -153,31 +155,32 @@ impl CellGrid {
 
     /// Bytes held on the heap.
     pub fn heap_bytes(&self) -> usize {
-        (self.place.capacity() + self.bigs.capacity()) * 4
+        self.place.capacity() * 4
+            + self.bigs.capacity() * size_of::<Label>()
             + self.list.heap_bytes()
             + self.scan_centre.capacity() * size_of::<DVec3>()
     }
 
     /// The large spheres (in no cell).
-    pub fn bigs(&self) -> &[u32] {
+    pub fn bigs(&self) -> &[Label] {
         &self.bigs
     }
 
     #[inline]
-    pub fn is_big(&self, i: usize) -> bool {
-        self.place[i] & BIG != 0
+    pub fn is_big(&self, i: Label) -> bool {
+        self.place[i.index()] & BIG != 0
     }
 
     /// Large sphere `i`'s index in `bigs`.
-    fn big_slot(&self, i: usize) -> usize {
-        let (Ok(k) | Err(k)) = self.bigs.binary_search(&(i as u32));
+    fn big_slot(&self, i: Label) -> usize {
+        let (Ok(k) | Err(k)) = self.bigs.binary_search(&i);
         k
     }
 
     /// Index of small sphere `i`'s cell.
     #[inline]
-    fn cell_of(&self, i: usize) -> usize {
-        let [x, y, z] = unpack(self.place[i]);
+    fn cell_of(&self, i: Label) -> usize {
+        let [x, y, z] = unpack(self.place[i.index()]);
         let q = self.padded;
         (x as usize + 1) + q * ((y as usize + 1) + q * (z as usize + 1))
     }
@@ -185,7 +188,7 @@ impl CellGrid {
     /// The broad-phase event of sphere `i` (at `b.t`): its next cell crossing,
     /// or for a large sphere the edge of its skin. Relative time.
     #[inline]
-    pub fn next_event(&self, i: usize, b: &Body) -> (f64, Event) {
+    pub fn next_event(&self, i: Label, b: &Body) -> (f64, Event) {
         if self.is_big(i) {
             let d = b.pos - self.scan_centre[self.big_slot(i)];
             let t = time_to_leave(d, b.vel, self.skin * (1.0 - 1e-6));
@@ -198,7 +201,7 @@ impl CellGrid {
             };
             return (t, ev);
         }
-        let coord = unpack(self.place[i]);
+        let coord = unpack(self.place[i.index()]);
         let last = self.per_side as u32 - 1;
         let mut best = f64::INFINITY;
         let mut mask = 0u8;
@@ -227,7 +230,7 @@ impl CellGrid {
 
     /// Sphere `i` crosses into the next cell as `mask` says.
     #[inline]
-    pub fn cross(&mut self, i: usize, mask: u8) {
+    pub fn cross(&mut self, i: Label, mask: u8) {
         let q = self.padded;
         let axis = (mask & 3) as usize;
         let stride = [1, q, q * q][axis];
@@ -235,39 +238,40 @@ impl CellGrid {
         let up = mask & 4 != 0;
         let to = if up { c + stride } else { c - stride };
         let one = 1 << (AXIS_BITS * axis as u32);
-        let p = &mut self.place[i];
+        let p = &mut self.place[i.index()];
         *p = if up { *p + one } else { *p - one };
         self.list.move_to(i, c, to);
     }
 
     /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
     /// every cell keeps its order.
-    pub fn relabel(&mut self, perm: &[u32], inv: &[u32]) {
+    #[cfg(feature = "experiments")]
+    pub fn relabel(&mut self, perm: &[Label], inv: &[Label]) {
         self.list.relabel(inv);
         apply(&mut self.place, perm);
-        let mut bigs: Vec<(u32, DVec3)> = self
+        let mut bigs: Vec<(Label, DVec3)> = self
             .bigs
             .iter()
             .zip(&self.scan_centre)
-            .map(|(&b, &c)| (inv[b as usize], c))
+            .map(|(&b, &c)| (inv[b.index()], c))
             .collect();
         bigs.sort_unstable_by_key(|b| b.0);
         (self.bigs, self.scan_centre) = bigs.into_iter().unzip();
     }
 
     /// A large sphere rescans from where it is now.
-    pub fn rescan(&mut self, i: usize, b: &Body) {
+    pub fn rescan(&mut self, i: Label, b: &Body) {
         let k = self.big_slot(i);
         self.scan_centre[k] = b.pos;
     }
 
     /// Every sphere that sphere `i` could touch before its next broad-phase
     /// event, into `out[..n]` (returns `n`; sphere `i` itself may be among
-    /// them): the 27 cells around a small one, the cells over a large one's
-    /// reach (its `radius` plus the bulk's and a skin) from its scan centre;
-    /// and every large sphere.
+    /// them), as [`Label::raw`]s: the 27 cells around a small one, the cells
+    /// over a large one's reach (its `radius` plus the bulk's and a skin)
+    /// from its scan centre; and every large sphere.
     #[inline]
-    pub fn candidates(&self, i: usize, radius: f64, out: &mut Vec<u32>) -> usize {
+    pub fn candidates(&self, i: Label, radius: f64, out: &mut Vec<u32>) -> usize {
         let n = if self.is_big(i) {
             let centre = self.scan_centre[self.big_slot(i)];
             let reach = DVec3::splat((radius + self.small_rmax + self.skin) * (1.0 + 1e-9));
@@ -287,7 +291,7 @@ impl CellGrid {
             return n;
         }
         out.truncate(n);
-        out.extend_from_slice(&self.bigs);
+        out.extend(self.bigs.iter().map(|b| b.raw()));
         out.len()
     }
 
@@ -305,7 +309,7 @@ impl CellGrid {
         cells: std::ops::Range<usize>,
         own: &mut Vec<u32>,
         near: &mut Vec<u32>,
-        mut f: impl FnMut(usize, usize),
+        mut f: impl FnMut(Label, Label),
     ) {
         for c in cells {
             // Most cells are empty (up to 4 a sphere); padding always is.
@@ -316,7 +320,7 @@ impl CellGrid {
             let m = self.list.gather_stencil(c, &self.forward, near);
             for (x, &i) in own[..k].iter().enumerate() {
                 for &j in own[x + 1..k].iter().chain(&near[..m]) {
-                    f(i as usize, j as usize);
+                    f(Label::from_raw(i), Label::from_raw(j));
                 }
             }
         }
@@ -328,7 +332,7 @@ impl CellGrid {
     /// Together with its best event over the old neighbourhood, these are
     /// all it could touch (Rapaport's trick: a crossing scans 9 cells, not 27).
     #[inline]
-    pub fn new_candidates(&self, i: usize, mask: u8, out: &mut Vec<u32>) -> usize {
+    pub fn new_candidates(&self, i: Label, mask: u8, out: &mut Vec<u32>) -> usize {
         let corner = self.cell_of(i) - self.stencil[0];
         self.list
             .gather_stencil(corner, &self.layers[mask as usize], out)

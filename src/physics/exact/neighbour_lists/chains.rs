@@ -3,89 +3,97 @@
 //! at a relist. Only rebuilds walk it; the cell-crossing broad phase, which
 //! gathers cells far more often, keeps its cells in
 //! [`CellBlocks`](crate::physics::exact::cell_grid::blocks::CellBlocks) instead.
-use crate::physics::exact::NONE;
+use crate::physics::exact::ids::{Cell, Label};
+#[cfg(feature = "experiments")]
 use crate::physics::exact::renumber::apply;
 
 #[derive(Clone, Debug, Default)]
 pub struct CellChains {
-    head: Vec<u32>,
-    next: Vec<u32>,
-    prev: Vec<u32>,
-    /// The cell of each sphere, `NONE` for one in no cell.
-    cell: Vec<u32>,
+    /// Each cell's first sphere, [`Label::NONE`] for an empty one.
+    head: Vec<Label>,
+    /// Each sphere's neighbours in its chain, [`Label::NONE`] at the ends.
+    next: Vec<Label>,
+    prev: Vec<Label>,
+    /// The cell of each sphere, [`Cell::NONE`] for one in no cell.
+    cell: Vec<Cell>,
 }
 
 impl CellChains {
     /// `spheres` spheres, none in a cell, and `cells` empty cells.
     pub fn reset(&mut self, spheres: usize, cells: usize) {
-        for v in [&mut self.next, &mut self.prev, &mut self.cell] {
+        for v in [&mut self.next, &mut self.prev] {
             v.clear();
-            v.resize(spheres, NONE);
+            v.resize(spheres, Label::NONE);
         }
+        self.cell.clear();
+        self.cell.resize(spheres, Cell::NONE);
         self.head.clear();
-        self.head.resize(cells, NONE);
+        self.head.resize(cells, Label::NONE);
     }
 
     #[inline]
-    pub fn cell(&self, i: usize) -> u32 {
-        self.cell[i]
+    pub fn cell(&self, i: Label) -> Cell {
+        self.cell[i.index()]
     }
 
     /// Bytes held on the heap.
     pub fn heap_bytes(&self) -> usize {
-        [&self.head, &self.next, &self.prev, &self.cell]
+        let labels: usize = [&self.head, &self.next, &self.prev]
             .iter()
-            .map(|v| v.capacity() * 4)
-            .sum()
+            .map(|v| v.capacity() * size_of::<Label>())
+            .sum();
+        labels + self.cell.capacity() * size_of::<Cell>()
     }
 
-    pub fn insert(&mut self, i: usize, c: usize) {
-        self.cell[i] = c as u32;
-        self.prev[i] = NONE;
-        self.next[i] = self.head[c];
-        if self.head[c] != NONE {
-            self.prev[self.head[c] as usize] = i as u32;
+    pub fn insert(&mut self, i: Label, c: usize) {
+        let head = self.head[c];
+        self.cell[i.index()] = Cell::at(c);
+        self.prev[i.index()] = Label::NONE;
+        self.next[i.index()] = head;
+        if head != Label::NONE {
+            self.prev[head.index()] = i;
         }
-        self.head[c] = i as u32;
+        self.head[c] = i;
     }
 
-    pub fn remove(&mut self, i: usize) {
-        let (p, n) = (self.prev[i], self.next[i]);
-        if p == NONE {
-            self.head[self.cell[i] as usize] = n;
+    pub fn remove(&mut self, i: Label) {
+        let (p, n) = (self.prev[i.index()], self.next[i.index()]);
+        if p == Label::NONE {
+            self.head[self.cell[i.index()].index()] = n;
         } else {
-            self.next[p as usize] = n;
+            self.next[p.index()] = n;
         }
-        if n != NONE {
-            self.prev[n as usize] = p;
+        if n != Label::NONE {
+            self.prev[n.index()] = p;
         }
     }
 
     /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
     /// every chain keeps its order.
-    pub fn relabel(&mut self, perm: &[u32], inv: &[u32]) {
+    #[cfg(feature = "experiments")]
+    pub fn relabel(&mut self, perm: &[Label], inv: &[Label]) {
         for v in [&mut self.head, &mut self.next, &mut self.prev] {
-            for x in v.iter_mut().filter(|x| **x != NONE) {
-                *x = inv[*x as usize];
+            for x in v.iter_mut().filter(|x| **x != Label::NONE) {
+                *x = inv[x.index()];
             }
         }
-        for v in [&mut self.next, &mut self.prev, &mut self.cell] {
-            apply(v, perm);
-        }
+        apply(&mut self.next, perm);
+        apply(&mut self.prev, perm);
+        apply(&mut self.cell, perm);
     }
 
-    pub fn move_to(&mut self, i: usize, c: usize) {
+    pub fn move_to(&mut self, i: Label, c: usize) {
         self.remove(i);
         self.insert(i, c);
     }
 
     /// Every sphere in cell `c`.
     #[inline]
-    pub fn for_each_in(&self, c: usize, mut f: impl FnMut(u32)) {
+    pub fn for_each_in(&self, c: usize, mut f: impl FnMut(Label)) {
         let mut j = self.head[c];
-        while j != NONE {
+        while j != Label::NONE {
             f(j);
-            j = self.next[j as usize];
+            j = self.next[j.index()];
         }
     }
 }

@@ -16,9 +16,10 @@
 //! reach.
 pub mod chains;
 
-use super::NONE;
 use super::body::{Bodies, Body};
+use super::ids::{Cell, Label};
 use super::large::{BIG_FACTOR, split_big, time_to_leave};
+#[cfg(feature = "experiments")]
 use super::renumber::{apply, apply_chunks};
 use chains::CellChains;
 use glam::DVec3;
@@ -45,8 +46,17 @@ struct Centre {
 /// in the neighbour's own list, so unlinking a pair is O(1) both ways.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Link {
-    pub j: u32,
+    pub j: Label,
     back: u32,
+}
+
+/// Where a sphere's list is kept: in the flat array (a bulk sphere) or,
+/// `Home(k)`, the `k`th of the large spheres' own lists.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Home(u32);
+
+impl Home {
+    const FLAT: Home = Home(u32::MAX);
 }
 
 /// Neighbour lists of the bulk spheres in one flat array with a fixed
@@ -58,8 +68,7 @@ struct Lists {
     stride: usize,
     flat: Vec<Link>,
     len: Vec<u32>,
-    /// Index into `big` for second-level spheres, else `NONE`.
-    slot: Vec<u32>,
+    home: Vec<Home>,
     big: Vec<Vec<Link>>,
 }
 
@@ -70,111 +79,109 @@ impl Lists {
         self.flat.resize(n * self.stride, Link::default());
         self.len.clear();
         self.len.resize(n, 0);
-        self.slot.clear();
-        self.slot.resize(n, NONE);
+        self.home.clear();
+        self.home.resize(n, Home::FLAT);
         self.big.clear();
     }
 
-    fn make_big(&mut self, i: usize) {
-        self.slot[i] = self.big.len() as u32;
+    fn make_big(&mut self, i: Label) {
+        self.home[i.index()] = Home(self.big.len() as u32);
         self.big.push(Vec::new());
     }
 
+    /// Where bulk sphere `i`'s list starts in `flat`, and its length.
+    #[inline(always)]
+    fn flat_range(&self, i: usize) -> std::ops::Range<usize> {
+        i * self.stride..i * self.stride + self.len[i] as usize
+    }
+
     #[inline]
-    fn of(&self, i: usize) -> &[Link] {
-        match self.slot[i] {
-            NONE => &self.flat[i * self.stride..i * self.stride + self.len[i] as usize],
-            s => &self.big[s as usize],
+    fn of(&self, i: Label) -> &[Link] {
+        match self.home[i.index()] {
+            Home::FLAT => &self.flat[self.flat_range(i.index())],
+            Home(k) => &self.big[k as usize],
         }
     }
 
     #[inline]
-    fn of_mut(&mut self, i: usize) -> &mut [Link] {
-        match self.slot[i] {
-            NONE => &mut self.flat[i * self.stride..i * self.stride + self.len[i] as usize],
-            s => &mut self.big[s as usize],
+    fn of_mut(&mut self, i: Label) -> &mut [Link] {
+        match self.home[i.index()] {
+            Home::FLAT => {
+                let r = self.flat_range(i.index());
+                &mut self.flat[r]
+            }
+            Home(k) => &mut self.big[k as usize],
         }
     }
 
     #[inline]
-    fn push(&mut self, i: usize, l: Link) {
-        match self.slot[i] {
-            NONE => {
+    fn push(&mut self, i: Label, l: Link) {
+        let i = i.index();
+        match self.home[i] {
+            Home::FLAT => {
                 if self.len[i] as usize == self.stride {
                     self.grow();
                 }
                 self.flat[i * self.stride + self.len[i] as usize] = l;
                 self.len[i] += 1;
             }
-            s => self.big[s as usize].push(l),
+            Home(k) => self.big[k as usize].push(l),
         }
     }
 
     #[inline]
-    fn pop(&mut self, i: usize) {
-        match self.slot[i] {
-            NONE => self.len[i] -= 1,
-            s => {
-                self.big[s as usize].pop();
+    fn pop(&mut self, i: Label) {
+        match self.home[i.index()] {
+            Home::FLAT => self.len[i.index()] -= 1,
+            Home(k) => {
+                self.big[k as usize].pop();
             }
         }
     }
 
     /// Make `i` and `j` neighbours.
     #[inline]
-    fn link(&mut self, i: usize, j: usize) {
+    fn link(&mut self, i: Label, j: Label) {
         let (li, lj) = (self.of(i).len() as u32, self.of(j).len() as u32);
-        self.push(
-            i,
-            Link {
-                j: j as u32,
-                back: lj,
-            },
-        );
-        self.push(
-            j,
-            Link {
-                j: i as u32,
-                back: li,
-            },
-        );
+        self.push(i, Link { j, back: lj });
+        self.push(j, Link { j: i, back: li });
     }
 
     /// Remove `i` from all its neighbours' lists and empty its own.
-    fn unlink_all(&mut self, i: usize) {
+    fn unlink_all(&mut self, i: Label) {
         for k in 0..self.of(i).len() {
             let Link { j, back } = self.of(i)[k];
-            let j = j as usize;
             let last = self.of(j).len() - 1;
             if back as usize != last {
                 // Move j's last entry into the hole and repoint its partner.
                 let moved = self.of(j)[last];
                 self.of_mut(j)[back as usize] = moved;
-                self.of_mut(moved.j as usize)[moved.back as usize].back = back;
+                self.of_mut(moved.j)[moved.back as usize].back = back;
             }
             self.pop(j);
         }
-        match self.slot[i] {
-            NONE => self.len[i] = 0,
-            s => self.big[s as usize].clear(),
+        match self.home[i.index()] {
+            Home::FLAT => self.len[i.index()] = 0,
+            Home(k) => self.big[k as usize].clear(),
         }
     }
 
     /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
     /// every list keeps its order, so the `back` places hold.
-    fn relabel(&mut self, perm: &[u32], inv: &[u32]) {
+    #[cfg(feature = "experiments")]
+    fn relabel(&mut self, perm: &[Label], inv: &[Label]) {
         apply_chunks(&mut self.flat, self.stride, perm);
         apply(&mut self.len, perm);
-        apply(&mut self.slot, perm);
+        apply(&mut self.home, perm);
         for i in 0..self.len.len() {
-            if self.slot[i] == NONE {
-                for l in self.of_mut(i) {
-                    l.j = inv[l.j as usize];
+            if self.home[i] == Home::FLAT {
+                for l in self.of_mut(Label::at(i)) {
+                    l.j = inv[l.j.index()];
                 }
             }
         }
         for l in self.big.iter_mut().flatten() {
-            l.j = inv[l.j as usize];
+            l.j = inv[l.j.index()];
         }
     }
 
@@ -200,7 +207,7 @@ pub struct NeighbourLists {
     inv_cell: f64,
     /// The spheres of each cell, by centre; second-level ones are in none.
     cells: CellChains,
-    bigs: Vec<u32>,
+    bigs: Vec<Label>,
     small_rmax: f64,
 }
 
@@ -211,7 +218,9 @@ impl NeighbourLists {
         let big: usize = l.big.iter().map(|b| b.capacity() * size_of::<Link>()).sum();
         self.centre.capacity() * size_of::<Centre>()
             + l.flat.capacity() * size_of::<Link>()
-            + (l.len.capacity() + l.slot.capacity() + self.bigs.capacity()) * 4
+            + l.len.capacity() * 4
+            + l.home.capacity() * size_of::<Home>()
+            + self.bigs.capacity() * size_of::<Label>()
             + l.big.capacity() * size_of::<Vec<Link>>()
             + big
             + self.cells.heap_bytes()
@@ -251,24 +260,24 @@ impl NeighbourLists {
         // fill them, which costs no more per rebuild and rebuilds less often.
         self.skin = (0.5 * size / self.per_side as f64 - self.small_rmax).max(skin);
         self.cells.reset(n, self.per_side.pow(3));
-        for (i, b) in bodies.iter().enumerate() {
+        for (i, b) in bodies.labels().zip(bodies.iter()) {
             if bodies.radius_of(b) > big_above {
-                self.bigs.push(i as u32);
+                self.bigs.push(i);
                 self.lists.make_big(i);
             } else {
                 self.cells.insert(i, self.cell_index(b.pos));
             }
         }
-        for i in 0..n {
+        for i in bodies.labels() {
             self.scan(i, bodies, |j| j > i);
         }
     }
 
     /// Sphere `i` (moved to the current time) gets a new centre and list.
-    pub fn rebuild(&mut self, i: usize, bodies: &Bodies) {
+    pub fn rebuild(&mut self, i: Label, bodies: &Bodies) {
         self.lists.unlink_all(i);
-        self.centre[i].pos = bodies[i].pos;
-        if self.cells.cell(i) != NONE {
+        self.centre[i.index()].pos = bodies[i].pos;
+        if self.cells.cell(i) != Cell::NONE {
             self.cells.move_to(i, self.cell_index(bodies[i].pos));
         }
         self.scan(i, bodies, |j| j != i);
@@ -276,46 +285,52 @@ impl NeighbourLists {
 
     /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
     /// every list and cell keeps its order.
-    pub fn relabel(&mut self, perm: &[u32], inv: &[u32]) {
+    #[cfg(feature = "experiments")]
+    pub fn relabel(&mut self, perm: &[Label], inv: &[Label]) {
         apply(&mut self.centre, perm);
         self.lists.relabel(perm, inv);
         self.cells.relabel(perm, inv);
         for b in &mut self.bigs {
-            *b = inv[*b as usize];
+            *b = inv[b.index()];
         }
     }
 
     #[inline]
-    pub fn of(&self, i: usize) -> &[Link] {
+    pub fn of(&self, i: Label) -> &[Link] {
         self.lists.of(i)
     }
 
     /// Time from `b.t` until sphere `i` has wandered to the edge of its skin.
     #[inline]
-    pub fn relist_time(&self, i: usize, b: &Body) -> f64 {
-        time_to_leave(b.pos - self.centre[i].pos, b.vel, self.skin * TRIGGER)
+    pub fn relist_time(&self, i: Label, b: &Body) -> f64 {
+        time_to_leave(
+            b.pos - self.centre[i.index()].pos,
+            b.vel,
+            self.skin * TRIGGER,
+        )
     }
 
     /// Find the neighbours `j` of `i` (with `want(j)`) and link both ways.
-    fn scan(&mut self, i: usize, bodies: &Bodies, want: impl Fn(usize) -> bool) {
-        let ci = self.centre[i].pos;
+    fn scan(&mut self, i: Label, bodies: &Bodies, want: impl Fn(Label) -> bool) {
+        let ci = self.centre[i.index()].pos;
         let ri = bodies.radius(i) + 2.0 * self.skin;
-        let test = |j: usize, centre: &[Centre], lists: &mut Lists| {
+        let test = |j: Label, centre: &[Centre], lists: &mut Lists| {
             if !want(j) {
                 return;
             }
-            let c = &centre[j];
+            let c = &centre[j.index()];
             let s = ri + c.radius;
             if (ci - c.pos).length_squared() < s * s {
                 lists.link(i, j);
             }
         };
-        let reach = if self.cells.cell(i) == NONE {
+        let big = self.cells.cell(i) == Cell::NONE;
+        let reach = if big {
             bodies.radius(i) + self.small_rmax + 2.0 * self.skin
         } else {
             0.0
         };
-        let (lo, hi) = if self.cells.cell(i) == NONE {
+        let (lo, hi) = if big {
             (
                 self.coords(ci - DVec3::splat(reach)),
                 self.coords(ci + DVec3::splat(reach)),
@@ -330,13 +345,13 @@ impl NeighbourLists {
             for y in lo[1]..=hi[1] {
                 for x in lo[0]..=hi[0] {
                     self.cells.for_each_in(x + p * (y + p * z), |j| {
-                        test(j as usize, &self.centre, &mut self.lists);
+                        test(j, &self.centre, &mut self.lists);
                     });
                 }
             }
         }
         for k in 0..self.bigs.len() {
-            test(self.bigs[k] as usize, &self.centre, &mut self.lists);
+            test(self.bigs[k], &self.centre, &mut self.lists);
         }
     }
 
