@@ -374,3 +374,109 @@ fn a_key_that_does_nothing_yet_keeps_its_notice_through_the_frame() {
     key(&mut a, KeyCode::Char('n'));
     assert_eq!(a.scene, before + 1);
 }
+
+fn auto(t: f64) -> ModelKind {
+    ModelKind::Auto(ballpit::physics::auto::Tolerance::new(t).unwrap())
+}
+
+#[test]
+fn angle_brackets_step_auto_s_tolerance_over_the_ladder() {
+    let mut a = AppState::new(
+        &Settings {
+            model: auto(0.0),
+            ..settings()
+        },
+        1000,
+        0.02,
+        30.0,
+    );
+    let ladder = [0.001, 0.01, 0.03, 0.1, 0.3, 1.0];
+    for t in ladder {
+        let scene = a.scene;
+        assert_eq!(
+            key(&mut a, KeyCode::Char('>')),
+            [Command::SetModel(auto(t))]
+        );
+        assert_eq!(a.model, auto(t));
+        assert_eq!(a.scene, scene + 1, "another model runs: another scene");
+        let n = a.notice.clone().unwrap();
+        assert!(n.starts_with(&format!("tolerance {t} ")), "{n}");
+    }
+    assert!(key(&mut a, KeyCode::Char('>')).is_empty());
+    assert!(a.notice.as_deref().unwrap().contains("limit 1"));
+    for t in ladder.iter().rev().skip(1).chain(&[0.0]) {
+        assert_eq!(
+            key(&mut a, KeyCode::Char('<')),
+            [Command::SetModel(auto(*t))]
+        );
+    }
+    assert!(key(&mut a, KeyCode::Char('<')).is_empty());
+    assert!(a.notice.as_deref().unwrap().contains("limit 0"));
+    assert_eq!(a.model, auto(0.0));
+}
+
+#[test]
+fn the_tolerance_keys_with_another_model_say_it_only_steers_auto_and_m_brings_it() {
+    let mut a = app();
+    assert_eq!(a.model, ModelKind::Swept);
+    assert!(key(&mut a, KeyCode::Char('>')).is_empty());
+    assert!(key(&mut a, KeyCode::Char('>')).is_empty());
+    let n = a.notice.clone().unwrap();
+    assert!(n.contains("0.01") && n.contains("only steers auto"), "{n}");
+    assert_eq!(a.model, ModelKind::Swept);
+    key(&mut a, KeyCode::Char('m'));
+    assert_eq!(
+        key(&mut a, KeyCode::Char('m')),
+        [Command::SetModel(auto(0.01))]
+    );
+}
+
+#[test]
+fn sync_shows_auto_s_switch_after_the_key_s_answer_and_takes_what_it_runs() {
+    use ballpit::engine::Engine;
+    use ballpit::physics::auto::Choice;
+    use ballpit::physics::{Sphere, World};
+    use glam::DVec3;
+    let spheres = vec![Sphere::new(DVec3::splat(0.3), DVec3::X, 0.05)];
+    let s = Settings {
+        model: auto(0.0),
+        threading: Threading::Pool,
+        ..settings()
+    };
+    let engine = Engine::new(World::new(1.0, spheres), s).unwrap();
+    let mut snap = engine.snapshot().clone();
+    let mut a = AppState::new(&s, 1, 0.05, 30.0);
+    snap.choice = Some(Choice {
+        model: ModelKind::Exact,
+        reason: "dense".into(),
+        unmet: false,
+    });
+    snap.switch_notice = Some("auto: swept → exact (dense)".into());
+    // No key of ours: the switch alone.
+    a.sync(&snap, false);
+    assert_eq!(a.notice.as_deref(), Some("auto: swept → exact (dense)"));
+    assert_eq!(a.running_model(), ModelKind::Exact);
+    // `exact` runs, so the pool size does nothing to it: the key says so.
+    key(&mut a, KeyCode::Char('P'));
+    assert!(
+        a.notice
+            .as_deref()
+            .unwrap()
+            .contains("exact runs on one thread")
+    );
+    // A key's answer first, then the switch it caused.
+    key(&mut a, KeyCode::Char('>'));
+    a.sync(&snap, true);
+    let n = a.notice.clone().unwrap();
+    assert!(
+        n.starts_with("tolerance 0.001") && n.ends_with("; auto: swept → exact (dense)"),
+        "{n}"
+    );
+    // The frame after: no switch, the notice stays until the next key.
+    snap.switch_notice = None;
+    a.sync(&snap, false);
+    assert_eq!(a.notice.as_deref(), Some(n.as_str()));
+    // Another model: what runs is the model itself.
+    key(&mut a, KeyCode::Char('m'));
+    assert_eq!(a.running_model(), ModelKind::Discrete);
+}

@@ -2,7 +2,8 @@
 //! world, the model, the executor, and the back snapshot to fill.
 use super::Settings;
 use super::snapshot::{Overlap, OverlapScratch, Snapshot};
-use crate::physics::{Exec, Model, World};
+use crate::physics::auto::Choice;
+use crate::physics::{Exec, Model, ModelKind, World};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -29,6 +30,9 @@ pub(crate) struct Frame {
     /// while a long frame runs.
     pub progress: Arc<AtomicU64>,
     scratch: OverlapScratch,
+    /// What `auto` ran in the last frame, to tell a switch (`None` for the
+    /// other models; kept across a new `auto`, as the tolerance keys make).
+    chosen: Option<ModelKind>,
 }
 
 impl Frame {
@@ -54,6 +58,7 @@ impl Frame {
             budget: None,
             progress: Arc::default(),
             scratch: OverlapScratch::default(),
+            chosen: None,
         }
     }
 
@@ -79,6 +84,13 @@ impl Frame {
                 || self.scratch.measure(&self.world, &*self.exec),
                 Overlap::complete,
             );
+        // A readout cut at its budget is a lower bound: the promise is not
+        // known kept (and which pairs were seen may differ between modes).
+        self.model.overlap_read(if overlap.partial {
+            f64::INFINITY
+        } else {
+            overlap.deepest_rel
+        });
         let physics_seconds = t0.elapsed().as_secs_f64();
         self.number += 1;
         let snap = &mut self.snap;
@@ -95,6 +107,8 @@ impl Frame {
         snap.steps = steps;
         snap.settings = self.settings;
         snap.choice = self.model.choice().cloned();
+        snap.switch_notice = switch_notice(self.chosen, snap.choice.as_ref());
+        self.chosen = snap.choice.as_ref().map(|c| c.model);
         snap.notice.clone_from(&self.notice);
     }
 
@@ -135,6 +149,17 @@ impl Frame {
             let per_step = spent.as_secs_f64() / done as f64;
             chunk = (left.as_secs_f64() / 4.0 / per_step.max(1e-9)).max(1.0) as u64;
         }
+    }
+}
+
+/// `auto: swept → exact (reason)` when `auto` runs another model than it
+/// ran in the frame before.
+fn switch_notice(was: Option<ModelKind>, now: Option<&Choice>) -> Option<String> {
+    match (was, now) {
+        (Some(was), Some(c)) if was != c.model => {
+            Some(format!("auto: {was} → {} ({})", c.model, c.reason))
+        }
+        _ => None,
     }
 }
 

@@ -393,10 +393,11 @@ impl Engine {
     }
 
     /// The threads the current settings put physics work on, driver first
-    /// (see [`physics_threads`]).
+    /// (see [`physics_threads`]); for `auto`, those of the model it runs.
     pub fn physics_threads(&self) -> Vec<String> {
         let s = &self.settings;
-        physics_threads(s.threading, s.threads, s.model)
+        let chosen = self.front.choice.as_ref().map(|c| c.model);
+        physics_threads(s.threading, s.threads, s.model.running(chosen))
     }
 
     fn check(&self) -> anyhow::Result<()> {

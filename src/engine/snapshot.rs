@@ -50,6 +50,9 @@ pub struct Snapshot {
     pub parts: u32,
     /// What `auto` chose to run and why (`None` for the other models).
     pub choice: Option<Choice>,
+    /// `auto` runs another model than in the frame before: `auto: swept →
+    /// exact (reason)`, a notice for the screen (only in that frame).
+    pub switch_notice: Option<String>,
     /// Wall-clock seconds the physics of this frame took: its steps and the
     /// detection behind `max_overlap_rel`.
     pub physics_seconds: f64,
@@ -88,6 +91,7 @@ impl Snapshot {
             counters: Counters::default(),
             parts: 1,
             choice: None,
+            switch_notice: None,
             physics_seconds: 0.0,
             steps: 0,
             settings,

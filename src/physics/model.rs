@@ -34,9 +34,20 @@ impl ModelKind {
     }
 
     /// Whether a step runs as one sequence on one lane, whatever the
-    /// executor offers: `exact` runs one event loop (`auto` may run any).
+    /// executor offers: `exact` runs one event loop. `auto` cannot say
+    /// alone: ask it of [`ModelKind::running`].
     pub fn runs_on_one_lane(self) -> bool {
         matches!(self, ModelKind::Exact)
+    }
+
+    /// The model that really runs: for `auto`, the one it chose (the
+    /// snapshot's `choice`) once it has chosen.
+    #[must_use]
+    pub fn running(self, chosen: Option<ModelKind>) -> ModelKind {
+        match (self, chosen) {
+            (ModelKind::Auto(_), Some(c)) => c,
+            (m, _) => m,
+        }
     }
 
     /// Whether a run of steps gives the same bits however it is cut into
@@ -95,6 +106,10 @@ pub trait Model: Send {
     fn max_overlap_rel(&mut self, _world: &World, _dt: f64, _exec: &dyn Exec) -> Option<f64> {
         None
     }
+    /// The deepest overlap the caller read after an `advance` (the model's
+    /// own answer or the caller's search; infinite when the search stopped
+    /// at its budget): `auto` checks its promise against it.
+    fn overlap_read(&mut self, _deepest_rel: f64) {}
     /// What `auto` chose to run and why (`None` for the other models).
     fn choice(&self) -> Option<&Choice> {
         None
@@ -133,5 +148,19 @@ mod tests {
         assert_eq!(loose.name(), "auto");
         assert_eq!(loose.next(), ModelKind::Discrete);
         assert_eq!(loose.tolerance().map(Tolerance::fraction), Some(0.1));
+    }
+
+    #[test]
+    fn auto_runs_on_the_lanes_of_its_choice() {
+        let auto = ModelKind::Auto(Tolerance::EXACT);
+        assert!(!auto.runs_on_one_lane());
+        assert!(auto.running(Some(ModelKind::Exact)).runs_on_one_lane());
+        assert!(!auto.running(Some(ModelKind::Swept)).runs_on_one_lane());
+        assert_eq!(auto.running(None), auto);
+        // Another model's stale choice is not what runs.
+        assert_eq!(
+            ModelKind::Swept.running(Some(ModelKind::Exact)),
+            ModelKind::Swept
+        );
     }
 }

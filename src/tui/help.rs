@@ -27,25 +27,101 @@ pub struct HelpOverlay {
     pub palette: Palette,
 }
 
-/// Columns of the key column, its leading space included.
+/// Columns of the key column, its leading space included; one less in
+/// two columns, where the widest keys (`q/Esc/^C`) still fit.
 const KEY_W: usize = 10;
+const KEY_W_NARROW: usize = 9;
+
+/// One row of one column: the keys (on a binding's first row only) and a
+/// piece of the description.
+type Cell = (String, String);
+
+/// The overlay's rows, each of one or two cells, and its outer size.
+struct Layout {
+    rows: Vec<Vec<Cell>>,
+    key_w: usize,
+    text_w: usize,
+    size: (u16, u16),
+}
 
 impl HelpOverlay {
-    /// Rows are " key      description ": the key column, the text, one
-    /// spare; the border carries the title and how to close it.
-    pub fn size() -> (u16, u16) {
-        let w = TABLE
+    /// One binding a row (" key      description ") while they fit `area`;
+    /// else two columns side by side, the descriptions wrapped, the table
+    /// cut where the two columns come out the most even.
+    fn layout(area: Rect) -> Layout {
+        let (aw, ah) = (usize::from(area.width), usize::from(area.height));
+        let whole = TABLE
             .iter()
             .map(|b| KEY_W + 2 + b.help.chars().count())
             .max()
             .unwrap_or(40);
-        (w as u16 + 2, TABLE.len() as u16 + 2)
+        if TABLE.len() + 2 <= ah && whole + 2 <= aw {
+            let rows = TABLE.iter().map(|b| vec![(b.keys(), b.help.into())]);
+            return Layout {
+                rows: rows.collect(),
+                key_w: KEY_W,
+                text_w: whole - KEY_W - 1,
+                size: (whole as u16 + 2, TABLE.len() as u16 + 2),
+            };
+        }
+        let col_w = aw.saturating_sub(2) / 2;
+        let text_w = col_w.saturating_sub(KEY_W_NARROW + 1).max(8);
+        let cells: Vec<Vec<Cell>> = TABLE
+            .iter()
+            .map(|b| {
+                let lines = wrap(b.help, text_w).into_iter().enumerate();
+                let key = |i: usize| if i == 0 { b.keys() } else { String::new() };
+                lines.map(|(i, t)| (key(i), t)).collect()
+            })
+            .collect();
+        let total: usize = cells.iter().map(Vec::len).sum();
+        let (mut left, mut best) = (0, (total, 0));
+        for (k, c) in cells.iter().enumerate() {
+            left += c.len();
+            let tall = left.max(total - left);
+            if tall < best.0 {
+                best = (tall, k + 1);
+            }
+        }
+        let (tall, cut) = best;
+        let column = |cs: &[Vec<Cell>]| cs.concat().into_iter();
+        let mut right = column(&cells[cut..]);
+        let rows: Vec<Vec<Cell>> = column(&cells[..cut])
+            .chain(std::iter::repeat_with(|| (String::new(), String::new())))
+            .take(tall)
+            .map(|l| [l].into_iter().chain(right.next()).collect())
+            .collect();
+        Layout {
+            size: (area.width, tall as u16 + 2),
+            rows,
+            key_w: KEY_W_NARROW,
+            text_w,
+        }
     }
+}
+
+/// `text` in lines of at most `w` characters, broken at spaces (a longer
+/// word stays whole and is clipped).
+fn wrap(text: &str, w: usize) -> Vec<String> {
+    let (mut lines, mut line) = (Vec::new(), String::new());
+    for word in text.split(' ') {
+        let n = line.chars().count();
+        if n > 0 && n + 1 + word.chars().count() > w {
+            lines.push(std::mem::take(&mut line));
+        }
+        if !line.is_empty() {
+            line.push(' ');
+        }
+        line.push_str(word);
+    }
+    lines.push(line);
+    lines
 }
 
 impl Widget for HelpOverlay {
     fn render(self, area: Rect, buf: &mut Buffer) {
-        let (w, h) = HelpOverlay::size();
+        let layout = HelpOverlay::layout(area);
+        let (w, h) = layout.size;
         let w = w.min(area.width);
         let h = h.min(area.height);
         let r = Rect::new(
@@ -55,16 +131,18 @@ impl Widget for HelpOverlay {
             h,
         );
         Clear.render(r, buf);
-        let lines: Vec<Line> = TABLE
-            .iter()
-            .map(|b| {
-                Line::from(vec![
-                    Span::styled(
-                        format!(" {:<w$}", b.keys(), w = KEY_W - 1),
-                        self.palette.label(),
-                    ),
-                    Span::raw(format!(" {}", b.help)),
-                ])
+        let (kw, tw) = (layout.key_w - 1, layout.text_w);
+        let lines: Vec<Line> = layout
+            .rows
+            .into_iter()
+            .map(|row| {
+                let spans = row.into_iter().flat_map(|(key, text)| {
+                    [
+                        Span::styled(format!(" {key:<kw$}"), self.palette.label()),
+                        Span::raw(format!(" {text:<tw$}")),
+                    ]
+                });
+                Line::from(spans.collect::<Vec<_>>())
             })
             .collect();
         Paragraph::new(lines)

@@ -22,6 +22,9 @@ pub enum Action {
     Smaller,
     Bigger,
     CycleModel,
+    /// `auto`'s tolerance one step of `Tolerance::LADDER` down / up.
+    Tighter,
+    Looser,
     Left,
     Right,
     Up,
@@ -90,6 +93,8 @@ mod tests {
             (KeyCode::Char('r'), Action::Smaller),
             (KeyCode::Char('R'), Action::Bigger),
             (KeyCode::Char('m'), Action::CycleModel),
+            (KeyCode::Char('<'), Action::Tighter),
+            (KeyCode::Char('>'), Action::Looser),
             (KeyCode::Left, Action::Left),
             (KeyCode::Right, Action::Right),
             (KeyCode::Up, Action::Up),

@@ -94,7 +94,7 @@ pub const TABLE: &[Binding] = &[
             (K::Esc, A::Escape),
             (K::Ctrl('c'), A::Quit),
         ],
-        help: "quit (Esc first closes this help, then the chart)",
+        help: "quit (Esc first closes the help, then the chart)",
         bar: Some(("quit", 1)),
     },
     Binding {
@@ -127,12 +127,12 @@ pub const TABLE: &[Binding] = &[
     },
     Binding {
         presses: &[(K::Char('x'), A::FlatOut)],
-        help: "flat out on/off: as many steps as each frame allows",
+        help: "flat out on/off: as many steps as a frame allows",
         bar: Some(("flat", 2)),
     },
     Binding {
         presses: &[(K::Char('['), A::TickDown), (K::Char(']'), A::TickUp)],
-        help: "physics tick - / + (0 freezes; up to 1000000, as --tick)",
+        help: "physics tick - / + (0 freezes; max 1000000)",
         bar: Some(("tick", 7)),
     },
     Binding {
@@ -157,6 +157,11 @@ pub const TABLE: &[Binding] = &[
         presses: &[(K::Char('m'), A::CycleModel)],
         help: "cycle collision model",
         bar: Some(("model", 10)),
+    },
+    Binding {
+        presses: &[(K::Char('<'), A::Tighter), (K::Char('>'), A::Looser)],
+        help: "auto's tolerance - / + (sinking, in radii)",
+        bar: Some(("tol", 17)),
     },
     Binding {
         presses: &[

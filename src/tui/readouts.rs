@@ -108,16 +108,18 @@ pub struct Readouts<'a> {
 impl Readouts<'_> {
     fn threading(&self) -> String {
         let s = self.state;
-        let threads = physics_threads(s.threading, s.threads, s.model).len();
+        // `auto` runs on the lanes of the model it chose.
+        let m = s.running_model();
+        let threads = physics_threads(s.threading, s.threads, m).len();
         match s.threading {
             Threading::Off => format!("off      on main; t -> {}", s.last_threaded),
             // A model on one lane does not split: say where it runs (a
             // pool hosts the whole frame on one of its threads).
-            Threading::Pool if s.model.runs_on_one_lane() => {
-                format!("{:<8} {} on 1 pool thread", Threading::Pool.name(), s.model)
+            Threading::Pool if m.runs_on_one_lane() => {
+                format!("{:<8} {} on 1 pool thread", Threading::Pool.name(), m)
             }
-            Threading::Split if s.model.runs_on_one_lane() => {
-                format!("{:<8} {} runs on physics", Threading::Split.name(), s.model)
+            Threading::Split if m.runs_on_one_lane() => {
+                format!("{:<8} {} runs on physics", Threading::Split.name(), m)
             }
             t => format!(
                 "{:<8} {threads} physics thread{}",

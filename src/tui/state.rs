@@ -5,6 +5,7 @@ use super::input::Action;
 use super::projection::Camera;
 use crate::engine::{Command, MAX_THREADS, Settings, Snapshot, Threading};
 use crate::physics::ModelKind;
+use crate::physics::auto::Tolerance;
 
 /// The most steps a frame runs, for `--tick` and the keys alike.
 pub const MAX_TICK: u32 = 1_000_000;
@@ -33,6 +34,11 @@ pub struct AppState {
     pub scene: u64,
     pub paused: bool,
     pub model: ModelKind,
+    /// `auto`'s tolerance (the `<` / `>` keys), kept while another model
+    /// runs so that `m` comes back to it.
+    pub tolerance: Tolerance,
+    /// What `auto` ran in the last frame (`None` for the other models).
+    pub chosen: Option<ModelKind>,
     pub count: usize,
     pub radius: f64,
     pub camera: Camera,
@@ -67,6 +73,8 @@ impl AppState {
             scene: 0,
             paused: false,
             model: settings.model,
+            tolerance: settings.model.tolerance().unwrap_or_default(),
+            chosen: None,
             count,
             radius,
             camera: Camera::default(),
@@ -156,9 +164,11 @@ impl AppState {
                             "pool threads {want}: kept for pool mode (now {})",
                             self.threading
                         ));
-                    } else if self.model.runs_on_one_lane() {
-                        self.notice =
-                            Some(format!("pool threads {want}: exact runs on one thread"));
+                    } else if self.running_model().runs_on_one_lane() {
+                        self.notice = Some(format!(
+                            "pool threads {want}: {} runs on one thread",
+                            self.running_model()
+                        ));
                     }
                 }
             }
@@ -231,9 +241,13 @@ impl AppState {
                 out.push(Command::SetRadius(self.radius));
             }
             Action::CycleModel => {
-                self.model = self.model.next();
+                self.model = match self.model.next() {
+                    ModelKind::Auto(_) => ModelKind::Auto(self.tolerance),
+                    m => m,
+                };
                 out.push(Command::SetModel(self.model));
             }
+            Action::Tighter | Action::Looser => out.extend(self.step_tolerance(action)),
             Action::Left => self.camera.yaw -= CAMERA_STEP,
             Action::Right => self.camera.yaw += CAMERA_STEP,
             Action::Up => self.camera.pitch = (self.camera.pitch + CAMERA_STEP).min(MAX_PITCH),
@@ -272,6 +286,8 @@ impl AppState {
                     | Action::Smaller
                     | Action::Bigger
                     | Action::CycleModel
+                    | Action::Tighter
+                    | Action::Looser
                     | Action::Reset
             )
         {
@@ -301,6 +317,32 @@ impl AppState {
         }
     }
 
+    /// The model that really runs: `auto`'s choice of the last frame.
+    pub fn running_model(&self) -> ModelKind {
+        self.model.running(self.chosen)
+    }
+
+    /// `<` / `>`: the tolerance one step of the ladder tighter / looser;
+    /// `auto` is asked again with it, the other models keep it for `m`.
+    fn step_tolerance(&mut self, action: Action) -> Option<Command> {
+        let want = self.tolerance.step(action == Action::Looser);
+        let auto = matches!(self.model, ModelKind::Auto(_));
+        let limit = if want == self.tolerance { "limit " } else { "" };
+        self.tolerance = want;
+        self.notice = Some(if auto {
+            format!("tolerance {limit}{want} of the smaller radius: auto chooses for it")
+        } else {
+            format!(
+                "tolerance {limit}{want}: it only steers auto ({} runs; m cycles to auto)",
+                self.model
+            )
+        });
+        (auto && limit.is_empty()).then(|| {
+            self.model = ModelKind::Auto(want);
+            Command::SetModel(self.model)
+        })
+    }
+
     /// The tick is kept while paused; it runs on resume.
     fn tell_if_paused(&mut self) {
         if self.paused && self.flat_out {
@@ -315,6 +357,7 @@ impl AppState {
     /// commands, so its notice (or the lack of one) answers them.
     pub fn sync(&mut self, snap: &Snapshot, applied: bool) {
         self.count = snap.count;
+        self.chosen = snap.choice.as_ref().map(|c| c.model);
         if let Some(r) = representative_radius(snap) {
             self.radius = r;
         }
@@ -330,6 +373,14 @@ impl AppState {
                 self.notice = None;
             }
             self.under_way = false;
+        }
+        // `auto` switched: said whatever caused it (a key, an edit, a broken
+        // promise), after the answer to the key that frame applied.
+        if let Some(sw) = &snap.switch_notice {
+            self.notice = Some(match (&self.notice, applied) {
+                (Some(k), true) => format!("{k}; {sw}"),
+                _ => sw.clone(),
+            });
         }
     }
 }

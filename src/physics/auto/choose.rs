@@ -8,15 +8,17 @@ use crate::physics::model::ModelKind;
 use crate::physics::world::World;
 use std::f64::consts::PI;
 
-/// Predicted cost of one `exact` event (contact, wall or cell crossing),
-/// of a sphere in a step, of a sphere's sync at the end of an `advance`,
-/// and of a sphere in the overlap readout the engine asks for each frame,
-/// in seconds: fitted to `ballpit bench` and `ballpit tradeoff` on the gas
-/// preset (docs/models.md, "auto").
+/// Predicted cost of one `exact` contact or wall event, of a cell
+/// crossing (it rescans only the cells it enters), of a sphere in a step,
+/// of a sphere's sync at the end of an `advance`, and of a sphere in the
+/// overlap readout the engine asks for each frame, in seconds: fitted to
+/// `ballpit bench` and `ballpit tradeoff` on the gas and projectiles
+/// presets (docs/models.md, "auto").
 const EXACT_EVENT: f64 = 4.4e-7;
+const EXACT_CROSSING: f64 = 2.0e-7;
 const EXACT_SPHERE_STEP: f64 = 1.8e-9;
 const EXACT_SPHERE_SYNC: f64 = 1.1e-8;
-const EXACT_SPHERE_READOUT: f64 = 4.3e-8;
+const EXACT_SPHERE_READOUT: f64 = 7.1e-8;
 /// `swept`: one sphere in one part of a step, and one contact or wall hit
 /// (its overlap readout is the next step's detection, reused).
 const SWEPT_SPHERE_STEP: f64 = 3.5e-8;
@@ -92,6 +94,10 @@ pub struct Rates {
     pub contacts: f64,
     pub walls: f64,
     pub crossings: f64,
+    /// How much dearer an `exact` event is than at its cells' design
+    /// occupancy (1): cells sized by the largest sphere hold many small
+    /// ones when radii spread, and every event scans its neighbours.
+    pub crowding: f64,
 }
 
 pub fn rates(s: &Summary) -> Rates {
@@ -101,6 +107,7 @@ pub fn rates(s: &Summary) -> Rates {
             contacts: 0.0,
             walls: 0.0,
             crossings: 0.0,
+            crowding: 1.0,
         };
     }
     let phi = s.packing.min(0.6);
@@ -120,10 +127,20 @@ pub fn rates(s: &Summary) -> Rates {
     } else {
         n * axis * per_side / s.size
     };
+    // Spheres in a cell and its 26 neighbours, against the 27/4 of cells
+    // as fine as (4 n)^(1/3) a side; half an event's cost there is its
+    // neighbour scan (docs/models.md, "auto"). Neighbour lists: no cells.
+    let near = 27.0 * n / per_side.powi(3);
+    let crowding = if s.packing > 0.3 {
+        1.0
+    } else {
+        (0.5 * (1.0 + near / 6.75)).max(1.0)
+    };
     Rates {
         contacts: 0.5 * n * per_sphere,
         walls: n * axis / s.size,
         crossings,
+        crowding,
     }
 }
 
@@ -146,7 +163,7 @@ pub fn costs(s: &Summary, dt: f64, swept_parts: u32, frame: u64, readouts: bool)
         discrete: DISCRETE_SPHERE_STEP * steps,
         swept: SWEPT_SPHERE_STEP * steps * f64::from(swept_parts.max(1))
             + SWEPT_EVENT * (r.contacts + r.walls),
-        exact: EXACT_EVENT * (r.contacts + r.walls + r.crossings)
+        exact: (EXACT_EVENT * (r.contacts + r.walls) + EXACT_CROSSING * r.crossings) * r.crowding
             + EXACT_SPHERE_STEP * steps
             + per_frame * frames,
     }

@@ -21,13 +21,14 @@ pub struct Tolerance(u32);
 impl Tolerance {
     pub const EXACT: Tolerance = Tolerance(0);
     const PER_UNIT: f64 = 1e6;
-    /// The `<` / `>` keys' steps.
-    pub const LADDER: [Tolerance; 6] = [
+    /// The `<` / `>` keys' steps, about ×3 apart from a thousandth up.
+    pub const LADDER: [Tolerance; 7] = [
         Tolerance(0),
         Tolerance(1_000),
         Tolerance(10_000),
+        Tolerance(30_000),
         Tolerance(100_000),
-        Tolerance(500_000),
+        Tolerance(300_000),
         Tolerance(1_000_000),
     ];
 
@@ -43,7 +44,9 @@ impl Tolerance {
         f64::from(self.0) / Self::PER_UNIT
     }
 
-    /// The next step of the ladder up (looser) or down (tighter).
+    /// The next step of the ladder up (looser) or down (tighter); a value
+    /// between steps (from `--tolerance`) goes to the neighbouring one, and
+    /// the ends stay where they are.
     #[must_use]
     pub fn step(self, looser: bool) -> Tolerance {
         let l = &Self::LADDER;
@@ -182,23 +185,43 @@ impl Model for Auto {
         self.inner.last_parts()
     }
 
-    /// `discrete` leaves the readout to the caller; `auto` needs it to
-    /// check its promise, so it measures it then (a grid pass, as the
-    /// engine's own would be).
+    /// `discrete` leaves the readout to the caller (the engine's grid pass
+    /// on the frame's executor); the others tell it from their own work.
     fn max_overlap_rel(&mut self, world: &World, dt: f64, exec: &dyn Exec) -> Option<f64> {
         self.read_since = true;
-        let depth = if self.inner.kind() == ModelKind::Discrete {
-            Some(world.max_overlap_rel())
-        } else {
-            self.inner.max_overlap_rel(world, dt, exec)
-        };
-        if depth.is_some_and(|d| d > self.tol.fraction() + 1e-9) {
+        self.inner.max_overlap_rel(world, dt, exec)
+    }
+
+    /// The promise is checked against the frame's readout, whoever made it.
+    fn overlap_read(&mut self, deepest_rel: f64) {
+        self.read_since = true;
+        if deepest_rel > self.tol.fraction() + 1e-9 {
             self.broke("overlap");
         }
-        depth
     }
 
     fn choice(&self) -> Option<&Choice> {
         self.choice.as_ref()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Tolerance;
+
+    #[test]
+    fn the_ladder_steps_both_ways_stops_at_its_ends_and_takes_in_between_values() {
+        let t = |x: f64| Tolerance::new(x).unwrap();
+        let mut up = vec![Tolerance::EXACT];
+        while up.last() != up.last().map(|x| x.step(true)).as_ref() {
+            up.push(up[up.len() - 1].step(true));
+        }
+        let fractions: Vec<f64> = up.iter().map(|x| x.fraction()).collect();
+        assert_eq!(fractions, [0.0, 0.001, 0.01, 0.03, 0.1, 0.3, 1.0]);
+        assert_eq!(t(1.0).step(true), t(1.0));
+        assert_eq!(t(0.0).step(false), t(0.0));
+        assert_eq!(t(0.3).step(false), t(0.1));
+        assert_eq!(t(0.05).step(true), t(0.1));
+        assert_eq!(t(0.05).step(false), t(0.03));
     }
 }
