@@ -92,8 +92,8 @@ fn enskog(w: &World) -> f64 {
 }
 
 /// 10 000 spheres at packing 0.4: after a melt of one `σ / v_rms` (about
-/// 12 collisions a sphere) the rate over the next `σ / v_rms` is Enskog's
-/// to 10 % (the walls lift it about 5 % at this size), with the energy kept,
+/// 13 collisions a sphere) the rate over the next `σ / v_rms` is Enskog's
+/// to 10 % (the walls lift the steady rate about 6 % at this size), with the energy kept,
 /// no sphere out and no overlap.
 #[test]
 fn the_dense_start_melts_to_enskogs_collision_rate() {
