@@ -8,7 +8,9 @@ pub enum Layout {
     Gas,
     /// Random positions, every sphere at exactly `speed` in a random direction.
     Uniform,
-    /// A jittered cubic lattice (random placement jams near 0.38).
+    /// A jittered cubic lattice over the whole box, `⌈∛N⌉` sites a side
+    /// (random placement jams near 0.38); it melts into the fluid at its
+    /// packing within about half a diameter's flight.
     Lattice,
     /// A touching row along x through the centre; the first sphere strikes it.
     Cradle,
