@@ -77,8 +77,9 @@ fn an_empty_box_reads_zero_not_minus_zero() {
 fn dump_reads_back_as_the_same_scene() {
     let dir = std::env::temp_dir().join(format!("ballpit-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
+    // Upper case reads as the same file type, as the screen's check has it.
     let a = dir.join("a.csv");
-    let b = dir.join("b.csv");
+    let b = dir.join("B.CSV");
     json(&[
         "--scene",
         "billiards",
@@ -98,6 +99,8 @@ fn dump_reads_back_as_the_same_scene() {
     ]);
     assert_eq!(v["n"], 8);
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    let v = json(&["--scene", b.to_str().unwrap(), "--steps", "0"]);
+    assert_eq!(v["n"], 8);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -45,15 +45,17 @@ fn wait_app(sh: &Link) {
 /// The value printed after `tag=` up to `|`, once it is on screen.
 fn printed(sh: &Link, tag: &str) -> String {
     let pat = format!("{tag}=");
-    let found = sh.wait_for(20.0, |s| {
-        s.lines()
-            .any(|l| l.find(&pat).is_some_and(|i| l[i..].contains('|')))
-    });
+    // The value on an output line: the echo of the typed `printf` line
+    // holds `tag=%d|` too, and may be on screen before the output is.
+    let value = |l: &str| {
+        let i = l.find(&pat)? + pat.len();
+        let (v, _) = l[i..].split_once('|')?;
+        (!l.contains("printf")).then(|| v.to_string())
+    };
+    let found = sh.wait_for(20.0, |s| s.lines().any(|l| value(l).is_some()));
     assert!(found.is_some(), "no {tag} on screen: {}", sh.text());
     let text = sh.text();
-    let l = text.lines().rev().find(|l| l.contains(&pat)).unwrap();
-    let i = l.find(&pat).unwrap() + pat.len();
-    l[i..].split('|').next().unwrap().to_string()
+    text.lines().rev().find_map(value).unwrap()
 }
 
 /// 12 quits in one shell: each about a second after the start, by `q`,

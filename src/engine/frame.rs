@@ -72,7 +72,7 @@ impl Frame {
     /// The timer covers the steps and the overlap readout's detection:
     /// `swept` makes it as the next step's detection and reuses it, the
     /// others search for overlaps; either way it is work the frame costs
-    /// (DESIGN.md: `wall_seconds` covers any detection for the readouts).
+    /// (docs/design.md, bench JSON: `wall_seconds` covers any detection for the readouts).
     /// Copying the spheres out for the screen is not timed.
     fn run_here(&mut self) {
         let t0 = Instant::now();

@@ -78,6 +78,14 @@ pub(crate) fn line_of(text: &str, at: usize) -> usize {
         + 1
 }
 
+/// `name` ends in `.ext`, in any case (`END.CSV` is a CSV, as the screen's
+/// check in `cli/screen.rs` reads it).
+fn has_extension(name: &str, ext: &str) -> bool {
+    Path::new(name)
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case(ext))
+}
+
 /// Build the world a spec describes, or say what is wrong with it.
 pub fn build_world(spec: &SceneSpec) -> Result<World, BadInput> {
     build_world_for(spec, None)
@@ -85,12 +93,8 @@ pub fn build_world(spec: &SceneSpec) -> Result<World, BadInput> {
 
 /// [`build_world`] for a run that starts with `model`: `discrete` takes a
 /// scene file with overlapping spheres (as its own `--dump` may hold).
-// The extensions are the documented lower-case ones; the checks read in the
-// order the messages promise.
-#[allow(
-    clippy::case_sensitive_file_extension_comparisons,
-    clippy::too_many_lines
-)]
+// The checks read in the order the messages promise.
+#[allow(clippy::too_many_lines)]
 pub fn build_world_for(spec: &SceneSpec, model: Option<ModelKind>) -> Result<World, BadInput> {
     let overlaps = if model == Some(ModelKind::Discrete) {
         place::Overlaps::Allow
@@ -109,7 +113,7 @@ pub fn build_world_for(spec: &SceneSpec, model: Option<ModelKind>) -> Result<Wor
         None
     };
     let scene = if stdin.is_some() { "stdin" } else { scene };
-    if scene.ends_with(".csv") || stdin.as_deref().is_some_and(looks_like_csv) {
+    if has_extension(scene, "csv") || stdin.as_deref().is_some_and(looks_like_csv) {
         if spec.count.is_some() || spec.radius.is_some() || spec.speed.is_some() {
             return bad!("--count, --radius and --speed do not apply to a CSV scene ({scene})");
         }
@@ -119,7 +123,7 @@ pub fn build_world_for(spec: &SceneSpec, model: Option<ModelKind>) -> Result<Wor
             None => csv_io::read(Path::new(scene), size, overlaps),
         };
     }
-    let (file, merged) = if scene.ends_with(".toml") || stdin.is_some() {
+    let (file, merged) = if has_extension(scene, "toml") || stdin.is_some() {
         let f = match &stdin {
             Some(text) if text.len() as u64 > toml_file::BOUND.max_bytes => {
                 return bad!(

@@ -271,9 +271,6 @@ impl Write for Sink {
     }
 }
 
-/// Big enough that a full 16-colour frame at 200×60 goes out in one write.
-pub const BUFFER_BYTES: usize = 256 * 1024;
-
 #[cfg(test)]
 mod tests {
     use super::*;

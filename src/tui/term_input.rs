@@ -186,10 +186,7 @@ fn parse_escape(b: &[u8]) -> Step {
         b'[' => parse_csi(b),
         b'O' => match b.get(2) {
             None => Step::Incomplete,
-            Some(&f) => Step::Event(
-                3,
-                arrow(f, KeyModifiers::NONE).map(|k| key(k, KeyModifiers::NONE)),
-            ),
+            Some(&f) => Step::Event(3, arrow(f).map(|k| key(k, KeyModifiers::NONE))),
         },
         // OSC, DCS, APC, PM, SOS: strings ended by BEL or ESC \.
         b']' | b'P' | b'_' | b'^' | b'X' => parse_string(b),
@@ -206,7 +203,7 @@ fn parse_escape(b: &[u8]) -> Step {
     }
 }
 
-fn arrow(f: u8, _mods: KeyModifiers) -> Option<KeyCode> {
+fn arrow(f: u8) -> Option<KeyCode> {
     Some(match f {
         b'A' => KeyCode::Up,
         b'B' => KeyCode::Down,
@@ -246,7 +243,7 @@ fn parse_csi(b: &[u8]) -> Step {
     let ev = match fin {
         b'A' | b'B' | b'C' | b'D' | b'H' | b'F' if !params.starts_with(['<', '?', '>']) => {
             let mods = nums.get(1).map_or(KeyModifiers::NONE, |&m| modifiers(m));
-            arrow(fin, mods).map(|k| key(k, mods))
+            arrow(fin).map(|k| key(k, mods))
         }
         b'n' if params == "0" => Some(Input::StatusOk),
         b'R' if nums.len() == 2 && !params.starts_with('?') => {
