@@ -7,6 +7,7 @@
 //! speeds spread over orders of magnitude stay about linear in cost. Tiny
 //! scenes use all pairs.
 mod level;
+mod place;
 
 use super::exec::{Exec, for_each_block_of, for_each_chunk};
 use super::sphere::Sphere;
