@@ -7,6 +7,7 @@
 //! path is not known here, is only noted, and the caller checks the two
 //! paths once both runs are done (see `rounds`). Each member's path is kept
 //! as the turns it took.
+use super::event::{Event, Local, WALL, pair_event, push_wall};
 use super::partition::Slot;
 use super::{REACH_SLACK, path_ball};
 use crate::physics::broad::Grid;
@@ -14,7 +15,6 @@ use crate::physics::contact::{pair_toi, reflect_walls, resolve_pair, wall_toi};
 use crate::physics::flight::fly;
 use crate::physics::sphere::Sphere;
 use glam::DVec3;
-use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 /// Runs with at most this many members check each other one by one on a
@@ -71,62 +71,6 @@ pub enum Coarse {
     Events,
     /// More work than its share of the step's budget.
     Work,
-}
-
-/// A sphere's index among a run's members: what the run's tables are
-/// indexed with, never a sphere id or a slot.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Local(u32);
-
-impl Local {
-    /// Not a member (of the run, or the wall of a wall event).
-    const NONE: Local = Local(u32::MAX);
-
-    fn at(index: usize) -> Local {
-        Local(index as u32)
-    }
-
-    fn index(self) -> usize {
-        self.0 as usize
-    }
-}
-
-/// `Event::b` of a wall event: no sphere.
-const WALL: u32 = u32::MAX;
-
-/// An event; `a`, `b` are sphere ids (`b` [`WALL`] for a wall), `la`, `lb` the
-/// run's local indices, `ca`, `cb` the collision counts it was predicted at.
-#[derive(Clone, Copy, Debug)]
-struct Event {
-    t: f64,
-    a: u32,
-    b: u32,
-    la: Local,
-    lb: Local,
-    ca: u32,
-    cb: u32,
-}
-
-impl PartialEq for Event {
-    fn eq(&self, o: &Self) -> bool {
-        self.cmp(o) == Ordering::Equal
-    }
-}
-impl Eq for Event {}
-impl PartialOrd for Event {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Event {
-    /// Reversed so the heap pops the earliest. Simultaneous events in a
-    /// fixed order that does not depend on how spheres were grouped: lower
-    /// sphere id first, pair events before wall events.
-    fn cmp(&self, o: &Self) -> Ordering {
-        o.t.total_cmp(&self.t)
-            .then(o.a.cmp(&self.a))
-            .then(o.b.cmp(&self.b))
-    }
 }
 
 /// A turn in a member's path: from time `t` of the step it is at
@@ -582,54 +526,5 @@ impl Run {
             self.heap
                 .push(pair_event(t + dtc, ia, j, Local::at(la), lb, ca, cb));
         }
-    }
-}
-
-fn pair_event(t: f64, a: u32, b: u32, la: Local, lb: Local, ca: u32, cb: u32) -> Event {
-    if a < b {
-        Event {
-            t,
-            a,
-            b,
-            la,
-            lb,
-            ca,
-            cb,
-        }
-    } else {
-        Event {
-            t,
-            a: b,
-            b: a,
-            la: lb,
-            lb: la,
-            ca: cb,
-            cb: ca,
-        }
-    }
-}
-
-#[allow(clippy::too_many_arguments)]
-fn push_wall(
-    heap: &mut BinaryHeap<Event>,
-    s: &Sphere,
-    a: u32,
-    la: Local,
-    t: f64,
-    ca: u32,
-    size: f64,
-    dt: f64,
-) {
-    let (tw, _) = wall_toi(s, size);
-    if t + tw <= dt {
-        heap.push(Event {
-            t: t + tw,
-            a,
-            b: WALL,
-            la,
-            lb: Local::NONE,
-            ca,
-            cb: 0,
-        });
     }
 }

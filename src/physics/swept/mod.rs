@@ -20,6 +20,7 @@
 //! pairs and clusters stay those of short paths (`parts.rs`).
 mod cluster;
 mod conflicts;
+mod event;
 mod group;
 #[cfg(feature = "experiments")]
 mod knobs;
