@@ -203,7 +203,9 @@ pub fn svg(s: &Sweep, path: &Path) -> anyhow::Result<()> {
         .x_desc(format!("threads (this machine: {} cores)", s.plan.cores))
         .y_desc("speed-up over off")
         .draw()?;
-    let ideal: Vec<(f64, f64)> = [1.0, top].iter().map(|&x| (x, x)).collect();
+    // Up to the top of the plot: a point beyond it would be clamped to the
+    // edge, bending the line.
+    let ideal: Vec<(f64, f64)> = [1.0, top.min(ymax * 1.5)].iter().map(|&x| (x, x)).collect();
     chart
         .draw_series(LineSeries::new(ideal, BLACK.mix(0.3)))?
         .label("ideal (speed-up = threads)")
@@ -246,7 +248,7 @@ pub fn svg(s: &Sweep, path: &Path) -> anyhow::Result<()> {
     }
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
+        .position(SeriesLabelPosition::LowerRight)
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .draw()?;
