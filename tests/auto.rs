@@ -443,12 +443,7 @@ fn the_model_row_says_what_auto_runs() {
         steps_per_second: 30.0,
         collisions_per_second: 1.0,
         detected: Some(Palette::True),
-        link: None,
-        link_slow: false,
-        under_way: None,
-        flat: Vec::new(),
-        flat_scene: 0,
-        flat_last: None,
+        ..Stats::default()
     };
     let mut t = ratatui::Terminal::new(ratatui::backend::TestBackend::new(
         72,

@@ -21,6 +21,9 @@ use ratatui::backend::TestBackend;
 use ratatui::layout::Rect;
 use ratatui::style::Modifier;
 use std::collections::BTreeMap;
+#[path = "common/names.rs"]
+mod names;
+use names::thread_names;
 
 fn settings(model: ModelKind, threading: Threading) -> Settings {
     Settings {
@@ -187,39 +190,30 @@ fn all_notices() -> BTreeMap<String, (AppState, Snapshot)> {
 }
 
 fn readouts<'a>(st: &'a AppState, snap: &'a Snapshot) -> Readouts<'a> {
-    const STATS: &Stats = &Stats {
+    static STATS: std::sync::LazyLock<Stats> = std::sync::LazyLock::new(|| Stats {
         fps: 30.0,
         physics_seconds: 0.001,
         render_seconds: 0.001,
         frame_bytes: 4000,
         steps_per_second: 30.0,
         collisions_per_second: 10.0,
-        detected: None,
-        link: None,
-        link_slow: false,
-        under_way: None,
-        flat: Vec::new(),
-        flat_scene: 0,
-        flat_last: None,
-    };
+        ..Stats::default()
+    });
     Readouts {
         state: st,
         snap,
-        stats: STATS,
+        stats: &STATS,
         palette: Palette::C16,
     }
 }
 
 /// The app's threads in `mode`, with `pool` pool threads.
 fn report(mode: Threading, pool: usize) -> CpuReport {
-    let mut names: Vec<String> = ["main", "physics", "signals", "input", "output"]
-        .map(String::from)
-        .to_vec();
-    match mode {
-        Threading::Pool => names.extend((0..pool).map(|i| format!("pool-{i}"))),
-        Threading::Split => names.extend(["split-pair".into(), "split-wall".into()]),
-        _ => {}
-    }
+    let names = thread_names(
+        &["main", "physics", "signals", "input", "output"],
+        mode,
+        pool,
+    );
     let threads: Vec<ThreadLoad> = (0..names.len())
         .zip(names)
         .map(|(i, name)| ThreadLoad {

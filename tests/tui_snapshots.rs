@@ -15,6 +15,9 @@ use glam::DVec3;
 use ratatui::Terminal;
 use ratatui::backend::TestBackend;
 use ratatui::style::Color;
+#[path = "common/names.rs"]
+mod names;
+use names::thread_names;
 
 fn settings() -> Settings {
     Settings {
@@ -78,14 +81,7 @@ fn report() -> CpuReport {
 /// The threads the app has in `mode` with `pool` pool threads, loaded
 /// unevenly, with a minute of history each.
 fn report_for(mode: Threading, pool: usize) -> CpuReport {
-    let mut names: Vec<String> = ["main", "physics", "signals", "input"]
-        .map(String::from)
-        .to_vec();
-    match mode {
-        Threading::Pool => names.extend((0..pool).map(|i| format!("pool-{i}"))),
-        Threading::Split => names.extend(["split-pair".to_string(), "split-wall".to_string()]),
-        _ => {}
-    }
+    let names = thread_names(&["main", "physics", "signals", "input"], mode, pool);
     // Loads a two-core machine could give: the more threads, the less each.
     let scale = (8.0 / names.len() as f64).min(1.0);
     let threads: Vec<ThreadLoad> = names
