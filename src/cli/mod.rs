@@ -163,8 +163,8 @@ impl ScalingArgs {
             let n = *spec.count.get_or_insert(SCALING_COUNT);
             if spec.radius.is_none() && n > 0 {
                 let size = spec.size.unwrap_or(1.0);
-                let volume = SCALING_PACKING * size.powi(3) / n as f64;
-                spec.radius = Some((volume * 3.0 / (4.0 * std::f64::consts::PI)).cbrt());
+                let each = SCALING_PACKING * size.powi(3) / n as f64;
+                spec.radius = Some((each / crate::physics::sphere::volume(1.0)).cbrt());
             }
         }
         spec

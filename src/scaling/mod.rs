@@ -194,7 +194,7 @@ pub fn measure(
     Ok(Sweep {
         plan: *plan,
         n: world.spheres.len(),
-        packing: packing(world),
+        packing: crate::physics::relax::packing(&world.spheres, world.size),
         steps,
         load_average: load_start
             .into_iter()
@@ -279,16 +279,6 @@ fn settings(plan: &Plan, c: Config, steps: u64) -> Settings {
         threading: c.threading,
         threads: c.threads,
     }
-}
-
-/// Sphere volume over the box's.
-fn packing(world: &World) -> f64 {
-    let v: f64 = world
-        .spheres
-        .iter()
-        .map(|s| 4.0 / 3.0 * std::f64::consts::PI * s.radius.powi(3))
-        .sum();
-    v / world.size.powi(3)
 }
 
 fn median(mut v: Vec<f64>) -> Option<f64> {
