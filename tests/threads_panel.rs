@@ -167,7 +167,7 @@ fn sparklines_tell_one_percent_from_fifteen() {
 
 #[test]
 fn s_sorts_the_rows_by_cpu_and_back() {
-    use ballpit::tui::input::Action;
+    use ballpit::tui::keys::Action;
     use ballpit::tui::state::AppState;
     let r = report(2);
     let draw = |by_cpu| {

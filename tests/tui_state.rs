@@ -3,7 +3,8 @@
 use ballpit::engine::{Command, Settings, Threading};
 use ballpit::physics::ModelKind;
 use ballpit::tui::canvas::{DrawStyle, LIGHT_STEPS};
-use ballpit::tui::input::{Action, action};
+use ballpit::tui::input::action;
+use ballpit::tui::keys::Action;
 use ballpit::tui::state::{AppState, CAMERA_STEP, MAX_PITCH, MAX_TICK, MIN_RADIUS, RADIUS_STEP};
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 

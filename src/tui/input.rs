@@ -1,47 +1,7 @@
 //! Keys to actions (docs/design.md, Keys). Kept apart from the state so the state
 //! can be tested without a terminal.
-use super::keys::{self, Press};
+use super::keys::{self, Action, Press};
 use crossterm::event::{KeyCode, KeyEvent, KeyEventKind, KeyModifiers};
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Action {
-    Quit,
-    /// Esc: closes the help if it is open, else the chart, else quits.
-    Escape,
-    ToggleThreading,
-    CycleThreadedMode,
-    FewerThreads,
-    MoreThreads,
-    /// Flat out (tick `max`) on/off, back to the tick before.
-    FlatOut,
-    TickDown,
-    TickUp,
-    Pause,
-    HalveCount,
-    DoubleCount,
-    Smaller,
-    Bigger,
-    CycleModel,
-    /// `auto`'s tolerance one step of `Tolerance::LADDER` down / up.
-    Tighter,
-    Looser,
-    Left,
-    Right,
-    Up,
-    Down,
-    CycleStyle,
-    MoveLight,
-    Reset,
-    Help,
-    SlowerFps,
-    FasterFps,
-    /// Swap the canvas for the chart of per-thread CPU, and back.
-    Chart,
-    /// Ctrl-Z: give the terminal back and stop (the input thread acts on it).
-    Suspend,
-    /// Sort the thread panel by CPU, and back to its fixed order.
-    SortThreads,
-}
 
 /// The key a press means, if any (releases are ignored). The keys are in
 /// `keys::TABLE`, the one place that lists them.

@@ -1,7 +1,47 @@
 //! The one key table: dispatch (`input::action`), the `?` overlay, the key
 //! bar and the README check (`tests/readme_keys.rs`) all read `TABLE`, so a
 //! key cannot be added in one place and forgotten in another.
-use super::input::Action;
+
+/// What a key asks for; `TABLE` binds the keys to them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Action {
+    Quit,
+    /// Esc: closes the help if it is open, else the chart, else quits.
+    Escape,
+    ToggleThreading,
+    CycleThreadedMode,
+    FewerThreads,
+    MoreThreads,
+    /// Flat out (tick `max`) on/off, back to the tick before.
+    FlatOut,
+    TickDown,
+    TickUp,
+    Pause,
+    HalveCount,
+    DoubleCount,
+    Smaller,
+    Bigger,
+    CycleModel,
+    /// `auto`'s tolerance one step of `Tolerance::LADDER` down / up.
+    Tighter,
+    Looser,
+    Left,
+    Right,
+    Up,
+    Down,
+    CycleStyle,
+    MoveLight,
+    Reset,
+    Help,
+    SlowerFps,
+    FasterFps,
+    /// Swap the canvas for the chart of per-thread CPU, and back.
+    Chart,
+    /// Ctrl-Z: give the terminal back and stop (the input thread acts on it).
+    Suspend,
+    /// Sort the thread panel by CPU, and back to its fixed order.
+    SortThreads,
+}
 
 /// A key as the table names it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,6 +1,8 @@
 //! The bytes that go to the terminal: one buffered write per frame, wrapped
 //! in synchronized output (DEC mode 2026) so a slow link never shows half a
 //! frame, and counted so the readouts can say what a frame costs.
+use super::escapes::{MoveRight, MoveTo, RESET_ATTRIBUTES, Sgr};
+use crossterm::queue;
 use ratatui::backend::{Backend, ClearType, CrosstermBackend, WindowSize};
 use ratatui::buffer::Cell;
 use ratatui::layout::{Position, Size};
@@ -81,7 +83,7 @@ impl<W: Write> Lean<W> {
     /// current background).
     fn reset_sgr(&mut self) -> io::Result<()> {
         if self.fg != Color::Reset || self.bg != Color::Reset || !self.modifier.is_empty() {
-            self.inner.write_all(b"\x1b[0m")?;
+            self.inner.write_all(RESET_ATTRIBUTES)?;
             self.fg = Color::Reset;
             self.bg = Color::Reset;
             self.modifier = Modifier::empty();
@@ -91,8 +93,8 @@ impl<W: Write> Lean<W> {
 }
 
 /// SGR parameters for a colour (foreground `base` 30, background 40).
-fn push_colour(out: &mut Vec<u8>, c: Color, base: u8) {
-    use std::io::Write as _;
+fn push_colour(out: &mut String, c: Color, base: u8) {
+    use std::fmt::Write as _;
     let basic = |n: u8| if n < 8 { base + n } else { base + 60 + n - 8 };
     let _ = match c {
         Color::Reset => write!(out, "{}", base + 9),
@@ -136,29 +138,24 @@ impl<W: Write> Backend for Lean<W> {
     where
         I: Iterator<Item = (u16, u16, &'a Cell)>,
     {
-        use std::io::Write as _;
+        use std::fmt::Write as _;
         let mut out: Vec<u8> = Vec::with_capacity(16 * 1024);
         let mut cursor: Option<(u16, u16)> = None;
-        let mut sgr: Vec<u8> = Vec::with_capacity(32);
+        let mut sgr = String::with_capacity(32);
         for (x, y, cell) in content {
             match cursor {
                 Some((cx, cy)) if cy == y && cx == x => {}
                 Some((cx, cy)) if cy == y && cx < x => {
-                    let n = x - cx;
-                    if n == 1 {
-                        out.extend_from_slice(b"\x1b[C");
-                    } else {
-                        let _ = write!(out, "\x1b[{n}C");
-                    }
+                    let _ = queue!(out, MoveRight(x - cx));
                 }
                 _ => {
-                    let _ = write!(out, "\x1b[{};{}H", y + 1, x + 1);
+                    let _ = queue!(out, MoveTo { x, y });
                 }
             }
             sgr.clear();
             if !(self.modifier - cell.modifier).is_empty() {
                 // Something to switch off: start from scratch.
-                sgr.push(b'0');
+                sgr.push('0');
                 self.fg = Color::Reset;
                 self.bg = Color::Reset;
                 self.modifier = Modifier::empty();
@@ -166,7 +163,7 @@ impl<W: Write> Backend for Lean<W> {
             for (m, code) in MODIFIER_CODES {
                 if cell.modifier.contains(m) && !self.modifier.contains(m) {
                     if !sgr.is_empty() {
-                        sgr.push(b';');
+                        sgr.push(';');
                     }
                     let _ = write!(sgr, "{code}");
                 }
@@ -179,22 +176,20 @@ impl<W: Write> Backend for Lean<W> {
             };
             if fg != self.fg {
                 if !sgr.is_empty() {
-                    sgr.push(b';');
+                    sgr.push(';');
                 }
                 push_colour(&mut sgr, fg, 30);
                 self.fg = fg;
             }
             if bg != self.bg {
                 if !sgr.is_empty() {
-                    sgr.push(b';');
+                    sgr.push(';');
                 }
                 push_colour(&mut sgr, bg, 40);
                 self.bg = bg;
             }
             if !sgr.is_empty() {
-                out.extend_from_slice(b"\x1b[");
-                out.extend_from_slice(&sgr);
-                out.push(b'm');
+                let _ = queue!(out, Sgr(&sgr));
             }
             let symbol = cell.symbol();
             out.extend_from_slice(symbol.as_bytes());

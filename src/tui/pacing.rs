@@ -13,8 +13,6 @@
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
-/// The question appended to every paced frame.
-pub const QUERY: &[u8] = b"\x1b[5n";
 /// How long the start-up probe waits for an answer.
 pub const PROBE: Duration = Duration::from_millis(200);
 /// A frame unanswered this long, plus its crossing at [`SLOWEST_LINK`],
@@ -90,7 +88,7 @@ pub struct Pacer {
 }
 
 impl Pacer {
-    /// Start probing; the caller writes [`QUERY`] now.
+    /// Start probing; the caller writes [`super::escapes::STATUS_QUERY`] now.
     pub fn new(now: Instant) -> Pacer {
         let mut p = Pacer {
             mode: Mode::Probing,

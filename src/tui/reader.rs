@@ -4,8 +4,10 @@
 //! resize cannot be lost (resizes come from the `signals` thread). End of
 //! input, hang-up and read errors mean the terminal is gone: the thread says
 //! so and stops, without spinning.
-use super::guard::{self, Msg};
-use super::input::Action;
+use super::keys::Action;
+use super::latch::TERMINAL;
+use super::msg::Msg;
+use super::quit;
 use super::signals;
 use super::term_input::{Input, Parser};
 use crossbeam_channel::Sender;
@@ -66,21 +68,23 @@ fn read_loop(tx: &Sender<Msg>) -> Option<String> {
         let mut quit = false;
         for ev in events.drain(..) {
             let msg = match ev {
-                Input::Key(k) => {
-                    match super::input::action(k) {
-                        Some(Action::Quit) => quit = true,
-                        Some(Action::Suspend) => {
-                            signals::request_suspend();
-                            continue;
-                        }
-                        _ => {}
+                // Keys are read as actions here, once: the frame loop gets
+                // only what a key means.
+                Input::Key(k) => match super::input::action(k) {
+                    Some(Action::Suspend) => {
+                        signals::request_suspend();
+                        continue;
                     }
-                    Msg::Key(k)
-                }
+                    Some(action) => {
+                        quit |= action == Action::Quit;
+                        Msg::Action(action)
+                    }
+                    None => continue,
+                },
                 // The pacing's answers: when they were read. A restore
                 // waits for the ones still owed.
                 Input::StatusOk => {
-                    guard::TERMINAL.answer();
+                    TERMINAL.answer();
                     Msg::Status(Instant::now())
                 }
                 // Pastes, focus changes and cursor reports are not commands.
@@ -94,7 +98,7 @@ fn read_loop(tx: &Sender<Msg>) -> Option<String> {
             // `q` and Ctrl-C end the app within a second even while a long
             // physics frame holds the frame loop; this thread goes on
             // reading the answers the restore waits for.
-            guard::end_after_grace(0);
+            quit::end_after_grace(0);
         }
     }
 }

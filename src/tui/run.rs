@@ -1,14 +1,16 @@
 //! The frame loop and its pacing.
 use super::app::{self, View};
 use super::canvas::Raster;
-use super::guard::{self, Guard, Msg};
+use super::escapes::STATUS_QUERY;
+use super::guard::{self, Guard};
+use super::msg::Msg;
 use super::output::{Counting, Lean, Sink};
-use super::pacing::{self, Pacer};
+use super::pacing::Pacer;
 use super::readouts::Stats;
 use super::state::AppState;
 use super::theme::Palette;
 use super::writer::Output;
-use super::{MAX_FPS, Options, input, reader, signals};
+use super::{MAX_FPS, Options, reader, signals};
 use crate::cpu::{CpuReport, Sampler};
 use crate::engine::{Command, Engine, Rebuild, Settings, Snapshot};
 use crate::error::BadInput;
@@ -187,7 +189,7 @@ impl FrameLoop {
     ) -> anyhow::Result<FrameLoop> {
         let output = Output::spawn(events)?;
         // The start-up probe: does the terminal answer status requests?
-        output.send(pacing::QUERY.to_vec(), 1);
+        output.send(STATUS_QUERY.to_vec(), 1);
         let pacer = Pacer::new(Instant::now());
         let sink = Sink::default();
         let (writer, bytes) = Counting::new(sink.clone());
@@ -317,10 +319,7 @@ impl FrameLoop {
     /// Returns whether the screen should answer at once.
     fn handle(&mut self, msg: Msg) -> anyhow::Result<bool> {
         match msg {
-            Msg::Key(k) => {
-                let Some(action) = input::action(k) else {
-                    return Ok(false);
-                };
+            Msg::Action(action) => {
                 for cmd in self.state.apply(action) {
                     self.engine.command(cmd);
                     self.pending = true;
@@ -460,7 +459,7 @@ impl FrameLoop {
         let frame = self.sink.take();
         let asked = self.pacer.asks();
         let chunk = if asked {
-            [pacing::QUERY, &frame, pacing::QUERY].concat()
+            [STATUS_QUERY, &frame, STATUS_QUERY].concat()
         } else {
             frame
         };
@@ -490,7 +489,7 @@ impl FrameLoop {
         self.held = false;
         let now = Instant::now();
         self.pacer = Pacer::new(now);
-        self.output.send(pacing::QUERY.to_vec(), 1);
+        self.output.send(STATUS_QUERY.to_vec(), 1);
         self.aspect = cell_aspect();
         self.terminal.autoresize()?;
         // Forgets what is on screen, so the next frame draws every cell.

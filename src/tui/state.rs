@@ -1,7 +1,7 @@
 //! What the user has asked for, and what each key does to it. Commands for
 //! the engine come out of `apply`; nothing here touches a terminal.
 use super::canvas::{DrawStyle, LIGHT_STEPS};
-use super::input::Action;
+use super::keys::Action;
 use super::projection::Camera;
 use crate::engine::{Command, MAX_THREADS, Settings, Snapshot, Threading};
 use crate::physics::ModelKind;

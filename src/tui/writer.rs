@@ -1,8 +1,9 @@
 //! The `output` thread: the one writer of frames. The frame loop hands it
 //! each frame's bytes and goes on handling keys, so a slow terminal never
 //! blocks the thread that answers them. It writes through the terminal's
-//! latch ([`guard::gated_stdout`]), so nothing lands after a restore.
-use super::guard::{self, Msg};
+//! latch ([`latch::gated_stdout`]), so nothing lands after a restore.
+use super::latch;
+use super::msg::Msg;
 use crossbeam_channel::Sender;
 use std::io;
 use std::thread;
@@ -20,7 +21,7 @@ impl Output {
         thread::Builder::new()
             .name("output".into())
             .spawn(move || {
-                let mut out = guard::gated_stdout();
+                let mut out = latch::gated_stdout();
                 for (chunk, queries) in rx {
                     let msg = match out.write_chunk(&chunk, queries) {
                         Ok(()) => Msg::Written,
