@@ -18,6 +18,7 @@ pub mod latch;
 pub mod msg;
 pub mod output;
 pub mod pacing;
+mod present;
 pub mod projection;
 pub mod quit;
 pub mod reader;

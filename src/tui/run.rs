@@ -1,29 +1,18 @@
 //! The frame loop and its pacing.
-use super::app::{self, View};
-use super::canvas::Raster;
-use super::escapes::STATUS_QUERY;
 use super::guard::{self, Guard};
 use super::msg::Msg;
-use super::output::{Counting, Lean, Sink};
-use super::pacing::Pacer;
+use super::present::{Presenter, Scene};
 use super::readouts::Stats;
 use super::state::AppState;
 use super::theme::Palette;
-use super::writer::Output;
 use super::{MAX_FPS, Options, reader, signals};
 use crate::cpu::{CpuReport, Sampler};
 use crate::engine::{Command, Engine, Rebuild, Settings, Snapshot};
 use crate::error::BadInput;
 use crate::physics::World;
 use anyhow::{Context, anyhow};
-use crossbeam_channel::{Receiver, RecvTimeoutError, Sender};
-use crossterm::queue;
-use crossterm::terminal::{BeginSynchronizedUpdate, EndSynchronizedUpdate};
-use ratatui::Terminal;
-use ratatui::backend::Backend;
+use crossbeam_channel::{Receiver, RecvTimeoutError};
 use std::io::{self, IsTerminal};
-use std::sync::Arc;
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 /// Per-thread CPU is sampled once a second: a minute of history is 60 bars.
@@ -103,11 +92,8 @@ pub fn run_with(
     let guard = Guard::enter(tx.clone()).context("cannot set up the terminal")?;
     let signals = signals::spawn(tx.clone())?;
     reader::spawn_input(tx.clone())?;
-    let mut result = FrameLoop::new(engine, state, palette, detected, tx).and_then(|mut l| {
-        l.after_first_frame = after_first_frame;
-        l.ascii = ascii;
-        l.run(&rx)
-    });
+    let mut result = Presenter::new(palette, ascii, after_first_frame, tx)
+        .and_then(|presenter| FrameLoop::new(engine, state, presenter, detected).run(&rx));
     // A panic restores the terminal, so the frame loop may stop on a refused
     // write first: the panic is the reason to report.
     if result.is_err() && guard::panicked() {
@@ -123,28 +109,16 @@ pub fn run_with(
     result
 }
 
-type Term = Terminal<Lean<Counting<Sink>>>;
-
 #[allow(clippy::struct_excessive_bools)] // independent flags of the loop's state
 struct FrameLoop {
     engine: Engine,
     state: AppState,
-    palette: Palette,
-    terminal: Term,
-    sink: Sink,
-    output: Output,
-    pacer: Pacer,
-    /// On a slow link, the snapshot last drawn: a key's update is drawn on
-    /// it, so only what the key changed crosses the link.
-    drawn: Option<Snapshot>,
+    presenter: Presenter,
     /// A key was handled since the last frame went out.
     update_wanted: bool,
-    bytes: Arc<AtomicU64>,
-    raster: Raster,
     stats: Stats,
     sampler: Sampler,
     report: CpuReport,
-    aspect: f64,
     /// The tick the engine was last told (0 while paused).
     sent_tick: u32,
     /// Commands sent that no frame has applied yet.
@@ -157,9 +131,6 @@ struct FrameLoop {
     /// Something on screen would change.
     dirty: bool,
     window: Window,
-    after_first_frame: Option<AfterFirstFrame>,
-    /// The locale is not UTF-8: every cell is drawn in ASCII.
-    ascii: bool,
     /// Stopped by job control: no physics, no frames, until resumed.
     held: bool,
     /// The frame in flight spanned a stop: its physics time is not load.
@@ -180,54 +151,22 @@ struct Window {
 }
 
 impl FrameLoop {
-    fn new(
-        engine: Engine,
-        state: AppState,
-        palette: Palette,
-        detected: Palette,
-        events: Sender<Msg>,
-    ) -> anyhow::Result<FrameLoop> {
-        let output = Output::spawn(events)?;
-        // The start-up probe: does the terminal answer status requests?
-        output.send(STATUS_QUERY.to_vec(), 1);
-        let pacer = Pacer::new(Instant::now());
-        let sink = Sink::default();
-        let (writer, bytes) = Counting::new(sink.clone());
-        let lean = Lean::new(writer);
-        // A terminal without colours gets no colour escape at all, whatever
-        // a widget asks for.
-        let lean = if palette.has_color() {
-            lean
-        } else {
-            lean.without_colours()
-        };
-        let mut terminal = Terminal::new(lean)?;
-        // Not `Terminal::clear`: it asks the terminal for the cursor position,
-        // a round trip that a slow link or a dumb pty may never answer.
-        Backend::clear(terminal.backend_mut())?;
+    fn new(engine: Engine, state: AppState, presenter: Presenter, detected: Palette) -> FrameLoop {
         let sent_tick = engine.settings().tick;
         let collisions = collisions(engine.snapshot());
         let mut sampler = Sampler::new();
         let report = sampler.sample().clone();
-        Ok(FrameLoop {
+        FrameLoop {
             engine,
             state,
-            palette,
-            terminal,
-            sink,
-            output,
-            pacer,
-            drawn: None,
+            presenter,
             update_wanted: false,
-            bytes,
-            raster: Raster::new(),
             stats: Stats {
                 detected: Some(detected),
                 ..Stats::default()
             },
             sampler,
             report,
-            aspect: cell_aspect(),
             sent_tick,
             pending: false,
             in_flight: None,
@@ -238,11 +177,9 @@ impl FrameLoop {
                 collisions_at_start: collisions,
                 ..Window::default()
             },
-            after_first_frame: None,
-            ascii: false,
             held: false,
             stopped_mid_frame: false,
-        })
+        }
     }
 
     fn run(mut self, rx: &Receiver<Msg>) -> anyhow::Result<()> {
@@ -261,7 +198,7 @@ impl FrameLoop {
             };
             if (self.dirty || self.update_wanted)
                 && !self.held
-                && let Some(t) = self.pacer.next_change()
+                && let Some(t) = self.presenter.pacer.next_change()
             {
                 deadline = deadline.min(t);
             }
@@ -282,7 +219,7 @@ impl FrameLoop {
                 return Ok(());
             }
             let now = Instant::now();
-            self.pacer.tick(now);
+            self.presenter.pacer.tick(now);
             if self.held {
                 // Nothing runs while the shell has the terminal; the
                 // figures start afresh on resume.
@@ -328,17 +265,16 @@ impl FrameLoop {
                 Ok(true)
             }
             Msg::Status(at) => {
-                self.pacer.answered(at);
+                self.presenter.pacer.answered(at);
                 Ok(false)
             }
             Msg::Written => {
-                self.pacer.written();
+                self.presenter.pacer.written();
                 Ok(false)
             }
             Msg::PhysicsDone => Ok(false),
             Msg::Resize => {
-                self.aspect = cell_aspect();
-                self.terminal.autoresize()?;
+                self.presenter.resize()?;
                 self.dirty = true;
                 Ok(true)
             }
@@ -407,9 +343,9 @@ impl FrameLoop {
     /// and a key's update at once (answer keys rather than wait for the
     /// next frame).
     fn present(&mut self) -> anyhow::Result<()> {
-        if self.dirty && self.pacer.may_send() {
+        if self.dirty && self.presenter.pacer.may_send() {
             self.draw(false)
-        } else if self.update_wanted && self.pacer.may_send_update() {
+        } else if self.update_wanted && self.presenter.pacer.may_send_update() {
             self.draw(true)
         } else {
             Ok(())
@@ -419,63 +355,19 @@ impl FrameLoop {
     /// Draw a frame, or with `update` a key's answer that keeps the canvas
     /// of the last frame when the link is slow.
     fn draw(&mut self, update: bool) -> anyhow::Result<()> {
-        let t0 = Instant::now();
         self.stats.under_way = self.engine.under_way();
-        let before = self.bytes.load(Ordering::Relaxed);
-        let slow = self.pacer.slow();
-        let keep_canvas = update && slow && self.drawn.is_some();
-        if !keep_canvas {
-            self.drawn = slow.then(|| self.engine.snapshot().clone());
-        }
-        let snap = match (&self.drawn, keep_canvas) {
-            (Some(s), true) => s,
-            _ => self.engine.snapshot(),
-        };
-        let view = View {
+        let scene = Scene {
             state: &self.state,
-            snap,
             stats: &self.stats,
             report: &self.report,
-            // On a slow link, frames without colours are much smaller.
-            palette: if self.pacer.cheap() {
-                Palette::Mono
-            } else {
-                self.palette
-            },
-            aspect: self.aspect,
         };
-        let raster = &mut self.raster;
-        queue!(self.terminal.backend_mut(), BeginSynchronizedUpdate)?;
-        let ascii = self.ascii;
-        self.terminal.draw(|f| {
-            app::draw(f, raster, &view);
-            if ascii {
-                super::caps::asciify(f.buffer_mut());
-            }
-        })?;
-        let backend = self.terminal.backend_mut();
-        queue!(backend, EndSynchronizedUpdate)?;
-        Backend::flush(backend)?;
-        let frame = self.sink.take();
-        let asked = self.pacer.asks();
-        let chunk = if asked {
-            [STATUS_QUERY, &frame, STATUS_QUERY].concat()
-        } else {
-            frame
-        };
-        let len = chunk.len();
-        // A write error comes back from the output thread as Msg::Fatal.
-        if !self.output.send(chunk, if asked { 2 } else { 0 }) {
-            return Err(anyhow!("the output thread stopped"));
-        }
-        self.pacer.sent(Instant::now(), len, asked);
-        if let Some(hook) = self.after_first_frame.take() {
-            hook();
-        }
-        self.window.render_seconds += t0.elapsed().as_secs_f64();
-        self.window.bytes += self.bytes.load(Ordering::Relaxed) - before;
+        let drawn = self
+            .presenter
+            .draw(self.engine.snapshot(), &scene, update)?;
+        self.window.render_seconds += drawn.seconds;
+        self.window.bytes += drawn.bytes;
         self.window.frames += 1;
-        if !keep_canvas {
+        if !drawn.kept_canvas {
             self.dirty = false;
         }
         self.update_wanted = false;
@@ -488,13 +380,7 @@ impl FrameLoop {
     fn resume(&mut self) -> anyhow::Result<()> {
         self.held = false;
         let now = Instant::now();
-        self.pacer = Pacer::new(now);
-        self.output.send(STATUS_QUERY.to_vec(), 1);
-        self.aspect = cell_aspect();
-        self.terminal.autoresize()?;
-        // Forgets what is on screen, so the next frame draws every cell.
-        self.terminal.clear()?;
-        self.drawn = None;
+        self.presenter.resume()?;
         self.dirty = true;
         // A sample now: the next readout spans only the time since, not
         // the stop (the report on screen stays the one before it).
@@ -526,8 +412,8 @@ impl FrameLoop {
             st.render_seconds = w.render_seconds / f64::from(w.frames);
             st.frame_bytes = w.bytes / u64::from(w.frames);
         }
-        st.link = Some(self.pacer.describe());
-        st.link_slow = self.pacer.slow();
+        st.link = Some(self.presenter.pacer.describe());
+        st.link_slow = self.presenter.pacer.slow();
         if w.physics_frames > 0 {
             st.physics_seconds = w.physics_seconds / f64::from(w.physics_frames);
         }
@@ -548,17 +434,4 @@ fn later(prev: Instant, period: Duration, now: Instant) -> Instant {
 
 fn collisions(snap: &Snapshot) -> u64 {
     snap.counters.sphere_collisions + snap.counters.wall_collisions
-}
-
-/// Cell height over width, from the terminal's pixel size when it says;
-/// 2 is the usual font.
-fn cell_aspect() -> f64 {
-    match crossterm::terminal::window_size() {
-        Ok(w) if w.width > 0 && w.height > 0 && w.columns > 0 && w.rows > 0 => {
-            let cw = f64::from(w.width) / f64::from(w.columns);
-            let ch = f64::from(w.height) / f64::from(w.rows);
-            (ch / cw).clamp(1.0, 3.0)
-        }
-        _ => 2.0,
-    }
 }
