@@ -110,18 +110,54 @@ impl AppState {
     pub fn apply(&mut self, action: Action) -> Vec<Command> {
         self.notice = None;
         self.under_way = false;
+        let out = match action {
+            Action::ToggleThreading
+            | Action::CycleThreadedMode
+            | Action::FewerThreads
+            | Action::MoreThreads => self.apply_threads(action),
+            Action::FlatOut | Action::TickDown | Action::TickUp | Action::Pause => {
+                self.apply_pace(action);
+                Vec::new()
+            }
+            Action::HalveCount
+            | Action::DoubleCount
+            | Action::Smaller
+            | Action::Bigger
+            | Action::CycleModel
+            | Action::Tighter
+            | Action::Looser
+            | Action::Reset => {
+                let out = self.apply_scene(action);
+                if !out.is_empty() {
+                    self.scene += 1;
+                }
+                out
+            }
+            _ => {
+                self.apply_view(action);
+                Vec::new()
+            }
+        };
+        if self.chart
+            && matches!(
+                action,
+                Action::Left
+                    | Action::Right
+                    | Action::Up
+                    | Action::Down
+                    | Action::CycleStyle
+                    | Action::MoveLight
+            )
+        {
+            self.notice = Some("the view changed behind the chart (c shows it)".into());
+        }
+        out
+    }
+
+    /// The threading keys: mode and pool size.
+    fn apply_threads(&mut self, action: Action) -> Vec<Command> {
         let mut out = Vec::new();
         match action {
-            Action::Quit => self.quit = true,
-            Action::Escape => {
-                if self.help {
-                    self.help = false;
-                } else if self.chart {
-                    self.chart = false;
-                } else {
-                    self.quit = true;
-                }
-            }
             Action::ToggleThreading => {
                 if self.threading == Threading::Off {
                     self.threading = self.last_threaded;
@@ -172,6 +208,14 @@ impl AppState {
                     }
                 }
             }
+            _ => {}
+        }
+        out
+    }
+
+    /// The pace keys: tick, flat out, pause (the loop sends the tick).
+    fn apply_pace(&mut self, action: Action) {
+        match action {
             Action::FlatOut => {
                 self.flat_out = !self.flat_out;
                 self.notice = Some(if self.flat_out {
@@ -207,6 +251,15 @@ impl AppState {
                 }
             }
             Action::Pause => self.paused = !self.paused,
+            _ => {}
+        }
+    }
+
+    /// The scene keys: what is simulated and by which model; every command
+    /// starts a new scene for the readouts.
+    fn apply_scene(&mut self, action: Action) -> Vec<Command> {
+        let mut out = Vec::new();
+        match action {
             Action::HalveCount => {
                 if self.count <= 1 {
                     self.notice = Some("count limit: 1 sphere".into());
@@ -248,6 +301,28 @@ impl AppState {
                 out.push(Command::SetModel(self.model));
             }
             Action::Tighter | Action::Looser => out.extend(self.step_tolerance(action)),
+            Action::Reset => {
+                out.push(Command::Reset);
+                self.notice = Some("scene back to its start".into());
+            }
+            _ => {}
+        }
+        out
+    }
+
+    /// The view keys: nothing for the engine.
+    fn apply_view(&mut self, action: Action) {
+        match action {
+            Action::Quit => self.quit = true,
+            Action::Escape => {
+                if self.help {
+                    self.help = false;
+                } else if self.chart {
+                    self.chart = false;
+                } else {
+                    self.quit = true;
+                }
+            }
             Action::Left => self.camera.yaw -= CAMERA_STEP,
             Action::Right => self.camera.yaw += CAMERA_STEP,
             Action::Up => self.camera.pitch = (self.camera.pitch + CAMERA_STEP).min(MAX_PITCH),
@@ -261,12 +336,7 @@ impl AppState {
             }
             Action::Chart => self.chart = !self.chart,
             Action::SortThreads => self.threads_by_cpu = !self.threads_by_cpu,
-            Action::Reset => {
-                out.push(Command::Reset);
-                self.notice = Some("scene back to its start".into());
-            }
             Action::Help => self.help = !self.help,
-            Action::Suspend => {} // the input thread stops the process
             Action::SlowerFps => match FPS_STEPS.iter().rev().find(|&&f| f < self.fps - 1e-9) {
                 Some(&f) => self.fps = f,
                 None => self.notice = Some(format!("fps limit: {}", FPS_STEPS[0])),
@@ -277,36 +347,9 @@ impl AppState {
                     self.notice = Some(format!("fps limit: {}", FPS_STEPS[FPS_STEPS.len() - 1]));
                 }
             },
+            // Suspend: the input thread stops the process.
+            _ => {}
         }
-        if !out.is_empty()
-            && matches!(
-                action,
-                Action::HalveCount
-                    | Action::DoubleCount
-                    | Action::Smaller
-                    | Action::Bigger
-                    | Action::CycleModel
-                    | Action::Tighter
-                    | Action::Looser
-                    | Action::Reset
-            )
-        {
-            self.scene += 1;
-        }
-        if self.chart
-            && matches!(
-                action,
-                Action::Left
-                    | Action::Right
-                    | Action::Up
-                    | Action::Down
-                    | Action::CycleStyle
-                    | Action::MoveLight
-            )
-        {
-            self.notice = Some("the view changed behind the chart (c shows it)".into());
-        }
-        out
     }
 
     /// The mode as flat out's comparison names it (a pool with its size).
