@@ -3,10 +3,8 @@
 use ballpit::engine::{Command, Settings, Threading};
 use ballpit::physics::ModelKind;
 use ballpit::tui::canvas::{DrawStyle, LIGHT_STEPS};
-use ballpit::tui::input::action;
-use ballpit::tui::keys::Action;
+use ballpit::tui::keys::{Action, Press, lookup};
 use ballpit::tui::state::{AppState, CAMERA_STEP, MAX_PITCH, MAX_TICK, MIN_RADIUS, RADIUS_STEP};
-use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 
 fn settings() -> Settings {
     Settings {
@@ -22,20 +20,20 @@ fn app() -> AppState {
     AppState::new(&settings(), 1000, 0.02, 30.0)
 }
 
-fn key(app: &mut AppState, code: KeyCode) -> Vec<Command> {
-    let a = action(KeyEvent::new(code, KeyModifiers::NONE)).expect("a mapped key");
+fn key(app: &mut AppState, press: Press) -> Vec<Command> {
+    let a = lookup(press).expect("a mapped key");
     app.apply(a)
 }
 
 #[test]
 fn q_esc_and_ctrl_c_quit() {
-    for code in [KeyCode::Char('q'), KeyCode::Esc] {
+    for code in [Press::Char('q'), Press::Esc] {
         let mut a = app();
         assert!(key(&mut a, code).is_empty());
         assert!(a.quit, "{code:?}");
     }
     let mut a = app();
-    let ctrl_c = action(KeyEvent::new(KeyCode::Char('c'), KeyModifiers::CONTROL)).unwrap();
+    let ctrl_c = lookup(Press::Ctrl('c')).unwrap();
     a.apply(ctrl_c);
     assert!(a.quit);
 }
@@ -43,12 +41,12 @@ fn q_esc_and_ctrl_c_quit() {
 #[test]
 fn esc_closes_the_help_before_it_quits() {
     let mut a = app();
-    key(&mut a, KeyCode::Char('?'));
+    key(&mut a, Press::Char('?'));
     assert!(a.help);
-    key(&mut a, KeyCode::Esc);
+    key(&mut a, Press::Esc);
     assert!(!a.help && !a.quit);
-    key(&mut a, KeyCode::Char('?'));
-    key(&mut a, KeyCode::Char('?'));
+    key(&mut a, Press::Char('?'));
+    key(&mut a, Press::Char('?'));
     assert!(!a.help);
 }
 
@@ -56,19 +54,19 @@ fn esc_closes_the_help_before_it_quits() {
 fn t_goes_off_to_the_last_threaded_mode_and_back() {
     let mut a = app();
     assert_eq!(
-        key(&mut a, KeyCode::Char('t')),
+        key(&mut a, Press::Char('t')),
         [Command::SetThreading(Threading::Worker)]
     );
     assert_eq!(a.threading, Threading::Worker);
-    key(&mut a, KeyCode::Char('d'));
+    key(&mut a, Press::Char('d'));
     assert_eq!(a.threading, Threading::Pool);
     assert_eq!(
-        key(&mut a, KeyCode::Char('t')),
+        key(&mut a, Press::Char('t')),
         [Command::SetThreading(Threading::Off)]
     );
     assert_eq!(a.threading, Threading::Off);
     assert_eq!(
-        key(&mut a, KeyCode::Char('t')),
+        key(&mut a, Press::Char('t')),
         [Command::SetThreading(Threading::Pool)]
     );
 }
@@ -76,36 +74,36 @@ fn t_goes_off_to_the_last_threaded_mode_and_back() {
 #[test]
 fn d_cycles_worker_pool_split_and_only_picks_while_off() {
     let mut a = app();
-    key(&mut a, KeyCode::Char('t'));
+    key(&mut a, Press::Char('t'));
     let mut seen = vec![];
     for _ in 0..3 {
-        let cmds = key(&mut a, KeyCode::Char('d'));
+        let cmds = key(&mut a, Press::Char('d'));
         assert_eq!(cmds, [Command::SetThreading(a.threading)]);
         seen.push(a.threading);
     }
     assert_eq!(seen, [Threading::Pool, Threading::Split, Threading::Worker]);
     // While off, `d` chooses what `t` will switch to, and sends nothing.
     let mut a = app();
-    assert!(key(&mut a, KeyCode::Char('d')).is_empty());
+    assert!(key(&mut a, Press::Char('d')).is_empty());
     assert_eq!(
         (a.threading, a.last_threaded),
         (Threading::Off, Threading::Pool)
     );
     assert!(a.notice.as_deref().unwrap().contains("pool"));
-    key(&mut a, KeyCode::Char('t'));
+    key(&mut a, Press::Char('t'));
     assert_eq!(a.threading, Threading::Pool);
 }
 
 #[test]
 fn p_and_shift_p_change_the_pool_within_limits() {
     let mut a = app();
-    assert_eq!(key(&mut a, KeyCode::Char('P')), [Command::SetThreads(5)]);
-    assert_eq!(key(&mut a, KeyCode::Char('p')), [Command::SetThreads(4)]);
+    assert_eq!(key(&mut a, Press::Char('P')), [Command::SetThreads(5)]);
+    assert_eq!(key(&mut a, Press::Char('p')), [Command::SetThreads(4)]);
     for _ in 0..3 {
-        key(&mut a, KeyCode::Char('p'));
+        key(&mut a, Press::Char('p'));
     }
     assert_eq!(a.threads, 1);
-    assert!(key(&mut a, KeyCode::Char('p')).is_empty());
+    assert!(key(&mut a, Press::Char('p')).is_empty());
     assert_eq!(a.threads, 1);
     assert!(a.notice.as_deref().unwrap().contains("limit"));
 }
@@ -115,17 +113,17 @@ fn brackets_change_the_tick_and_zero_freezes() {
     let mut a = app();
     // The tick goes to the engine at the next frame (0 while paused), so the
     // key itself sends nothing.
-    assert!(key(&mut a, KeyCode::Char(']')).is_empty());
+    assert!(key(&mut a, Press::Char(']')).is_empty());
     assert_eq!(a.tick, 2);
-    key(&mut a, KeyCode::Char('['));
-    key(&mut a, KeyCode::Char('['));
+    key(&mut a, Press::Char('['));
+    key(&mut a, Press::Char('['));
     assert_eq!(a.tick, 0);
     assert!(!a.running());
-    key(&mut a, KeyCode::Char('['));
+    key(&mut a, Press::Char('['));
     assert_eq!(a.tick, 0);
     assert!(a.notice.as_deref().unwrap().contains("frozen"));
     a.tick = MAX_TICK;
-    key(&mut a, KeyCode::Char(']'));
+    key(&mut a, Press::Char(']'));
     assert_eq!(a.tick, MAX_TICK);
 }
 
@@ -133,31 +131,31 @@ fn brackets_change_the_tick_and_zero_freezes() {
 fn space_pauses_and_resumes() {
     let mut a = app();
     assert!(a.running());
-    key(&mut a, KeyCode::Char(' '));
+    key(&mut a, Press::Char(' '));
     assert!(a.paused && !a.running());
-    key(&mut a, KeyCode::Char(' '));
+    key(&mut a, Press::Char(' '));
     assert!(a.running());
 }
 
 #[test]
 fn n_halves_and_shift_n_doubles_the_count() {
     let mut a = app();
-    assert_eq!(key(&mut a, KeyCode::Char('N')), [Command::SetCount(2000)]);
-    assert_eq!(key(&mut a, KeyCode::Char('n')), [Command::SetCount(1000)]);
+    assert_eq!(key(&mut a, Press::Char('N')), [Command::SetCount(2000)]);
+    assert_eq!(key(&mut a, Press::Char('n')), [Command::SetCount(1000)]);
     a.count = 1;
-    assert!(key(&mut a, KeyCode::Char('n')).is_empty());
+    assert!(key(&mut a, Press::Char('n')).is_empty());
     assert_eq!(a.count, 1);
 }
 
 #[test]
 fn r_and_shift_r_scale_the_radius() {
     let mut a = app();
-    let cmds = key(&mut a, KeyCode::Char('R'));
+    let cmds = key(&mut a, Press::Char('R'));
     assert_eq!(cmds, [Command::SetRadius(0.02 * RADIUS_STEP)]);
-    let cmds = key(&mut a, KeyCode::Char('r'));
+    let cmds = key(&mut a, Press::Char('r'));
     assert_eq!(cmds, [Command::SetRadius(0.02 * RADIUS_STEP / RADIUS_STEP)]);
     a.radius = MIN_RADIUS;
-    assert!(key(&mut a, KeyCode::Char('r')).is_empty());
+    assert!(key(&mut a, Press::Char('r')).is_empty());
     assert_eq!(a.radius, MIN_RADIUS);
 }
 
@@ -165,11 +163,11 @@ fn r_and_shift_r_scale_the_radius() {
 fn m_cycles_the_model() {
     let mut a = app();
     let first = a.model;
-    let cmds = key(&mut a, KeyCode::Char('m'));
+    let cmds = key(&mut a, Press::Char('m'));
     assert_eq!(cmds, [Command::SetModel(first.next())]);
     assert_ne!(a.model, first);
     for _ in 1..ModelKind::ALL.len() {
-        key(&mut a, KeyCode::Char('m'));
+        key(&mut a, Press::Char('m'));
     }
     assert_eq!(a.model, first);
 }
@@ -178,18 +176,18 @@ fn m_cycles_the_model() {
 fn arrows_rotate_the_camera_and_pitch_stops_short_of_the_pole() {
     let mut a = app();
     let c0 = a.camera;
-    key(&mut a, KeyCode::Left);
+    key(&mut a, Press::Left);
     assert!((a.camera.yaw - (c0.yaw - CAMERA_STEP)).abs() < 1e-12);
-    key(&mut a, KeyCode::Right);
-    key(&mut a, KeyCode::Right);
+    key(&mut a, Press::Right);
+    key(&mut a, Press::Right);
     assert!((a.camera.yaw - (c0.yaw + CAMERA_STEP)).abs() < 1e-12);
-    key(&mut a, KeyCode::Up);
+    key(&mut a, Press::Up);
     assert!((a.camera.pitch - (c0.pitch + CAMERA_STEP)).abs() < 1e-12);
-    key(&mut a, KeyCode::Down);
-    key(&mut a, KeyCode::Down);
+    key(&mut a, Press::Down);
+    key(&mut a, Press::Down);
     assert!((a.camera.pitch - (c0.pitch - CAMERA_STEP)).abs() < 1e-12);
     for _ in 0..40 {
-        key(&mut a, KeyCode::Up);
+        key(&mut a, Press::Up);
     }
     assert_eq!(a.camera.pitch, MAX_PITCH);
 }
@@ -198,17 +196,17 @@ fn arrows_rotate_the_camera_and_pitch_stops_short_of_the_pole() {
 fn v_cycles_the_styles_and_l_moves_the_light_round() {
     let mut a = app();
     assert_eq!(a.style, DrawStyle::PointsSpeed);
-    key(&mut a, KeyCode::Char('v'));
+    key(&mut a, Press::Char('v'));
     assert_eq!(a.style, DrawStyle::PointsDepth);
-    key(&mut a, KeyCode::Char('v'));
+    key(&mut a, Press::Char('v'));
     assert_eq!(a.style, DrawStyle::Shaded);
-    key(&mut a, KeyCode::Char('v'));
+    key(&mut a, Press::Char('v'));
     assert_eq!(a.style, DrawStyle::PointsSpeed);
-    key(&mut a, KeyCode::Char('l'));
+    key(&mut a, Press::Char('l'));
     assert!(a.notice.as_deref().unwrap().contains("shaded"));
     a.style = DrawStyle::Shaded;
     for i in 2..=LIGHT_STEPS + 1 {
-        key(&mut a, KeyCode::Char('l'));
+        key(&mut a, Press::Char('l'));
         assert_eq!(a.light, i % LIGHT_STEPS);
         assert!(a.notice.is_none());
     }
@@ -217,16 +215,16 @@ fn v_cycles_the_styles_and_l_moves_the_light_round() {
 #[test]
 fn zero_resets_the_scene() {
     let mut a = app();
-    assert_eq!(key(&mut a, KeyCode::Char('0')), [Command::Reset]);
+    assert_eq!(key(&mut a, Press::Char('0')), [Command::Reset]);
 }
 
 #[test]
 fn f_and_shift_f_step_the_frame_rate() {
     let mut a = app();
-    key(&mut a, KeyCode::Char('F'));
+    key(&mut a, Press::Char('F'));
     assert_eq!(a.fps, 60.0);
-    key(&mut a, KeyCode::Char('f'));
-    key(&mut a, KeyCode::Char('f'));
+    key(&mut a, Press::Char('f'));
+    key(&mut a, Press::Char('f'));
     assert_eq!(a.fps, 20.0);
     let mut b = AppState::new(&settings(), 10, 0.1, 24.0);
     b.apply(Action::FasterFps);
@@ -242,9 +240,9 @@ fn threading_given_on_the_command_line_is_what_t_returns_to() {
     let mut s = settings();
     s.threading = Threading::Split;
     let mut a = AppState::new(&s, 10, 0.1, 30.0);
-    key(&mut a, KeyCode::Char('t'));
+    key(&mut a, Press::Char('t'));
     assert_eq!(a.threading, Threading::Off);
-    key(&mut a, KeyCode::Char('t'));
+    key(&mut a, Press::Char('t'));
     assert_eq!(a.threading, Threading::Split);
 }
 
@@ -260,7 +258,7 @@ fn sync_takes_the_real_count_radius_and_the_engine_notice() {
     let engine = Engine::new(World::new(1.0, spheres), settings()).unwrap();
     let mut snap = engine.snapshot().clone();
     let mut a = app();
-    key(&mut a, KeyCode::Char('N'));
+    key(&mut a, Press::Char('N'));
     snap.notice = Some("count limit: no free space".into());
     a.sync(&snap, true);
     assert_eq!((a.count, a.radius), (2, 0.1));
@@ -270,7 +268,7 @@ fn sync_takes_the_real_count_radius_and_the_engine_notice() {
     a.sync(&snap, false);
     assert!(a.notice.is_some());
     // The next key's frame, with no limit hit, leaves no notice.
-    key(&mut a, KeyCode::Char('n'));
+    key(&mut a, Press::Char('n'));
     a.sync(&snap, true);
     assert!(a.notice.is_none());
 }
@@ -279,16 +277,16 @@ fn sync_takes_the_real_count_radius_and_the_engine_notice() {
 fn c_swaps_the_canvas_for_the_chart_and_back() {
     let mut a = app();
     assert!(!a.chart);
-    assert!(key(&mut a, KeyCode::Char('c')).is_empty());
+    assert!(key(&mut a, Press::Char('c')).is_empty());
     assert!(a.chart);
     // Keys for the hidden canvas still act, and say why nothing shows.
     let yaw = a.camera.yaw;
-    key(&mut a, KeyCode::Left);
+    key(&mut a, Press::Left);
     assert!(a.camera.yaw < yaw);
     assert!(a.notice.as_deref().unwrap().contains("chart"));
-    key(&mut a, KeyCode::Char('c'));
+    key(&mut a, Press::Char('c'));
     assert!(!a.chart);
-    key(&mut a, KeyCode::Left);
+    key(&mut a, Press::Left);
     assert!(a.notice.is_none());
 }
 
@@ -296,7 +294,7 @@ fn c_swaps_the_canvas_for_the_chart_and_back() {
 fn p_while_not_in_pool_mode_keeps_the_size_and_says_where_it_applies() {
     let mut a = app();
     assert_eq!(a.threading, Threading::Off);
-    assert_eq!(key(&mut a, KeyCode::Char('P')), [Command::SetThreads(5)]);
+    assert_eq!(key(&mut a, Press::Char('P')), [Command::SetThreads(5)]);
     assert_eq!(a.threads, 5);
     let n = a.notice.clone().unwrap();
     assert!(
@@ -305,19 +303,19 @@ fn p_while_not_in_pool_mode_keeps_the_size_and_says_where_it_applies() {
     );
     // In pool mode the key just acts.
     a.threading = Threading::Pool;
-    assert_eq!(key(&mut a, KeyCode::Char('p')), [Command::SetThreads(4)]);
+    assert_eq!(key(&mut a, Press::Char('p')), [Command::SetThreads(4)]);
     assert!(a.notice.is_none());
     // In pool mode with exact, the size has no effect either.
     a.model = ModelKind::Exact;
-    key(&mut a, KeyCode::Char('P'));
+    key(&mut a, Press::Char('P'));
     assert!(a.notice.as_deref().unwrap().contains("exact"));
 }
 
 #[test]
 fn tick_keys_while_paused_say_the_tick_runs_on_resume() {
     let mut a = app();
-    key(&mut a, KeyCode::Char(' '));
-    key(&mut a, KeyCode::Char(']'));
+    key(&mut a, Press::Char(' '));
+    key(&mut a, Press::Char(']'));
     assert_eq!(a.tick, 2);
     assert!(a.notice.as_deref().unwrap().contains("resumed"));
 }
@@ -327,16 +325,16 @@ fn x_toggles_flat_out_and_goes_back_to_the_tick_before() {
     let mut a = app();
     a.tick = 0;
     assert!(!a.running());
-    key(&mut a, KeyCode::Char('x'));
+    key(&mut a, Press::Char('x'));
     assert!(a.flat_out && a.running());
     // Flat out needs a tick above 0 for the engine; the tick is kept.
     assert_eq!((a.tick, a.engine_tick()), (0, 1));
     assert!(a.notice.as_deref().unwrap().contains("flat out"));
     // The tick keys leave the tick alone while flat out, and say so.
-    key(&mut a, KeyCode::Char(']'));
+    key(&mut a, Press::Char(']'));
     assert_eq!(a.tick, 0);
     assert!(a.notice.as_deref().unwrap().contains("x goes back"));
-    key(&mut a, KeyCode::Char('x'));
+    key(&mut a, Press::Char('x'));
     assert!(!a.flat_out && !a.running());
 }
 
@@ -345,11 +343,11 @@ fn esc_closes_the_help_then_the_chart_then_quits() {
     let mut a = app();
     a.help = true;
     a.chart = true;
-    key(&mut a, KeyCode::Esc);
+    key(&mut a, Press::Esc);
     assert!(!a.help && a.chart && !a.quit);
-    key(&mut a, KeyCode::Esc);
+    key(&mut a, Press::Esc);
     assert!(!a.chart && !a.quit);
-    key(&mut a, KeyCode::Esc);
+    key(&mut a, Press::Esc);
     assert!(a.quit);
 }
 
@@ -364,15 +362,15 @@ fn a_key_that_does_nothing_yet_keeps_its_notice_through_the_frame() {
     .snapshot()
     .clone();
     snap.notice = None;
-    key(&mut a, KeyCode::Char('P'));
+    key(&mut a, Press::Char('P'));
     a.sync(&snap, true);
     assert!(a.notice.as_deref().unwrap().contains("kept for pool mode"));
-    key(&mut a, KeyCode::Char('0'));
+    key(&mut a, Press::Char('0'));
     a.sync(&snap, true);
     assert!(a.notice.as_deref().unwrap().contains("back to its start"));
     // Changes of scene are counted, so flat out's comparison starts again.
     let before = a.scene;
-    key(&mut a, KeyCode::Char('n'));
+    key(&mut a, Press::Char('n'));
     assert_eq!(a.scene, before + 1);
 }
 
@@ -394,24 +392,18 @@ fn angle_brackets_step_auto_s_tolerance_over_the_ladder() {
     let ladder = [0.001, 0.01, 0.03, 0.1, 0.3, 1.0];
     for t in ladder {
         let scene = a.scene;
-        assert_eq!(
-            key(&mut a, KeyCode::Char('>')),
-            [Command::SetModel(auto(t))]
-        );
+        assert_eq!(key(&mut a, Press::Char('>')), [Command::SetModel(auto(t))]);
         assert_eq!(a.model, auto(t));
         assert_eq!(a.scene, scene + 1, "another model runs: another scene");
         let n = a.notice.clone().unwrap();
         assert!(n.starts_with(&format!("tolerance {t} ")), "{n}");
     }
-    assert!(key(&mut a, KeyCode::Char('>')).is_empty());
+    assert!(key(&mut a, Press::Char('>')).is_empty());
     assert!(a.notice.as_deref().unwrap().contains("limit 1"));
     for t in ladder.iter().rev().skip(1).chain(&[0.0]) {
-        assert_eq!(
-            key(&mut a, KeyCode::Char('<')),
-            [Command::SetModel(auto(*t))]
-        );
+        assert_eq!(key(&mut a, Press::Char('<')), [Command::SetModel(auto(*t))]);
     }
-    assert!(key(&mut a, KeyCode::Char('<')).is_empty());
+    assert!(key(&mut a, Press::Char('<')).is_empty());
     assert!(a.notice.as_deref().unwrap().contains("limit 0"));
     assert_eq!(a.model, auto(0.0));
 }
@@ -420,14 +412,14 @@ fn angle_brackets_step_auto_s_tolerance_over_the_ladder() {
 fn the_tolerance_keys_with_another_model_say_it_only_steers_auto_and_m_brings_it() {
     let mut a = app();
     assert_eq!(a.model, ModelKind::Swept);
-    assert!(key(&mut a, KeyCode::Char('>')).is_empty());
-    assert!(key(&mut a, KeyCode::Char('>')).is_empty());
+    assert!(key(&mut a, Press::Char('>')).is_empty());
+    assert!(key(&mut a, Press::Char('>')).is_empty());
     let n = a.notice.clone().unwrap();
     assert!(n.contains("0.01") && n.contains("only steers auto"), "{n}");
     assert_eq!(a.model, ModelKind::Swept);
-    key(&mut a, KeyCode::Char('m'));
+    key(&mut a, Press::Char('m'));
     assert_eq!(
-        key(&mut a, KeyCode::Char('m')),
+        key(&mut a, Press::Char('m')),
         [Command::SetModel(auto(0.01))]
     );
 }
@@ -458,7 +450,7 @@ fn sync_shows_auto_s_switch_after_the_key_s_answer_and_takes_what_it_runs() {
     assert_eq!(a.notice.as_deref(), Some("auto: swept → exact (dense)"));
     assert_eq!(a.running_model(), ModelKind::Exact);
     // `exact` runs, so the pool size does nothing to it: the key says so.
-    key(&mut a, KeyCode::Char('P'));
+    key(&mut a, Press::Char('P'));
     assert!(
         a.notice
             .as_deref()
@@ -466,7 +458,7 @@ fn sync_shows_auto_s_switch_after_the_key_s_answer_and_takes_what_it_runs() {
             .contains("exact runs on one thread")
     );
     // A key's answer first, then the switch it caused.
-    key(&mut a, KeyCode::Char('>'));
+    key(&mut a, Press::Char('>'));
     a.sync(&snap, true);
     let n = a.notice.clone().unwrap();
     assert!(
@@ -478,6 +470,6 @@ fn sync_shows_auto_s_switch_after_the_key_s_answer_and_takes_what_it_runs() {
     a.sync(&snap, false);
     assert_eq!(a.notice.as_deref(), Some(n.as_str()));
     // Another model: what runs is the model itself.
-    key(&mut a, KeyCode::Char('m'));
+    key(&mut a, Press::Char('m'));
     assert_eq!(a.running_model(), ModelKind::Discrete);
 }

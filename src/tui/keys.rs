@@ -1,4 +1,4 @@
-//! The one key table: dispatch (`input::action`), the `?` overlay, the key
+//! The one key table: dispatch (`lookup`), the `?` overlay, the key
 //! bar and the README check (`tests/readme_keys.rs`) all read `TABLE`, so a
 //! key cannot be added in one place and forgotten in another.
 
@@ -279,6 +279,47 @@ pub fn bar_width(keys: &str, label: &str) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_design_key_maps_to_its_action() {
+        let table = [
+            (Press::Char('q'), Action::Quit),
+            (Press::Esc, Action::Escape),
+            (Press::Char('t'), Action::ToggleThreading),
+            (Press::Char('d'), Action::CycleThreadedMode),
+            (Press::Char('p'), Action::FewerThreads),
+            (Press::Char('P'), Action::MoreThreads),
+            (Press::Char('['), Action::TickDown),
+            (Press::Char(']'), Action::TickUp),
+            (Press::Char(' '), Action::Pause),
+            (Press::Char('n'), Action::HalveCount),
+            (Press::Char('N'), Action::DoubleCount),
+            (Press::Char('r'), Action::Smaller),
+            (Press::Char('R'), Action::Bigger),
+            (Press::Char('m'), Action::CycleModel),
+            (Press::Char('<'), Action::Tighter),
+            (Press::Char('>'), Action::Looser),
+            (Press::Left, Action::Left),
+            (Press::Right, Action::Right),
+            (Press::Up, Action::Up),
+            (Press::Down, Action::Down),
+            (Press::Char('v'), Action::CycleStyle),
+            (Press::Char('l'), Action::MoveLight),
+            (Press::Char('0'), Action::Reset),
+            (Press::Char('?'), Action::Help),
+            (Press::Char('f'), Action::SlowerFps),
+            (Press::Char('F'), Action::FasterFps),
+            (Press::Char('c'), Action::Chart),
+            (Press::Char('s'), Action::SortThreads),
+            (Press::Char('x'), Action::FlatOut),
+        ];
+        for (press, want) in table {
+            assert_eq!(lookup(press), Some(want), "{press:?}");
+        }
+        assert_eq!(lookup(Press::Ctrl('c')), Some(Action::Quit));
+        assert_eq!(lookup(Press::Char('y')), None);
+        assert_eq!(lookup(Press::Ctrl('t')), None);
+    }
 
     #[test]
     fn no_key_is_bound_twice() {

@@ -12,7 +12,6 @@ pub mod chart;
 pub mod escapes;
 pub mod guard;
 pub mod help;
-pub mod input;
 pub mod keys;
 pub mod latch;
 pub mod msg;

@@ -4,7 +4,7 @@
 //! resize cannot be lost (resizes come from the `signals` thread). End of
 //! input, hang-up and read errors mean the terminal is gone: the thread says
 //! so and stops, without spinning.
-use super::keys::Action;
+use super::keys::{self, Action};
 use super::latch::TERMINAL;
 use super::msg::Msg;
 use super::quit;
@@ -70,7 +70,7 @@ fn read_loop(tx: &Sender<Msg>) -> Option<String> {
             let msg = match ev {
                 // Keys are read as actions here, once: the frame loop gets
                 // only what a key means.
-                Input::Key(k) => match super::input::action(k) {
+                Input::Key(press) => match keys::lookup(press) {
                     Some(Action::Suspend) => {
                         signals::request_suspend();
                         continue;

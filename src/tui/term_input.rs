@@ -10,12 +10,13 @@
 //! acted on: pasted text is not a sequence of commands). Everything else
 //! (function keys, mouse reports, OSC/DCS strings) is consumed and dropped,
 //! as are invalid bytes. Sequences may be split across reads anywhere.
-use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+use super::keys::Press;
 
 /// What the terminal said.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Input {
-    Key(KeyEvent),
+    /// A key the key table can name (others are read and dropped).
+    Key(Press),
     /// The answer to a device status request (`ESC[5n`): the terminal has
     /// consumed everything written before the request.
     StatusOk,
@@ -56,7 +57,7 @@ impl Parser {
     pub fn flush_escape(&mut self, out: &mut Vec<Input>) {
         if self.escape_pending() {
             self.pending.clear();
-            out.push(key(KeyCode::Esc, KeyModifiers::NONE));
+            out.push(Input::Key(Press::Esc));
         }
     }
 
@@ -123,25 +124,18 @@ enum Step {
     Incomplete,
 }
 
-fn key(code: KeyCode, mods: KeyModifiers) -> Input {
-    Input::Key(KeyEvent::new(code, mods))
+fn key(p: Press) -> Input {
+    Input::Key(p)
 }
 
 fn parse_one(b: &[u8]) -> Step {
     match b[0] {
         ESC => parse_escape(b),
-        0x00 => Step::Event(1, Some(key(KeyCode::Char(' '), KeyModifiers::CONTROL))),
-        b'\r' | b'\n' => Step::Event(1, Some(key(KeyCode::Enter, KeyModifiers::NONE))),
-        b'\t' => Step::Event(1, Some(key(KeyCode::Tab, KeyModifiers::NONE))),
-        0x08 | 0x7f => Step::Event(1, Some(key(KeyCode::Backspace, KeyModifiers::NONE))),
-        c @ 0x01..=0x1a => Step::Event(
-            1,
-            Some(key(
-                KeyCode::Char((c - 1 + b'a') as char),
-                KeyModifiers::CONTROL,
-            )),
-        ),
-        0x1c..=0x1f => Step::Event(1, None),
+        0x00 => Step::Event(1, Some(key(Press::Ctrl(' ')))),
+        // Enter, Tab, Backspace and the other controls name no key of the
+        // table (before the letters: Tab is Ctrl-I).
+        b'\r' | b'\n' | b'\t' | 0x08 | 0x7f | 0x1c..=0x1f => Step::Event(1, None),
+        c @ 0x01..=0x1a => Step::Event(1, Some(key(Press::Ctrl((c - 1 + b'a') as char)))),
         _ => parse_char(b),
     }
 }
@@ -164,15 +158,9 @@ fn parse_char(b: &[u8]) -> Step {
     }
     match std::str::from_utf8(&b[..need]) {
         Ok(s) => {
+            // `P` is the key `P`: Shift is in the character.
             let c = s.chars().next().unwrap_or(' ');
-            let mods = if c.is_uppercase() {
-                KeyModifiers::SHIFT
-            } else {
-                KeyModifiers::NONE
-            };
-            // crossterm reports `P` as Char('P') with SHIFT; input.rs matches
-            // on the char alone, so the modifier is only informative.
-            Step::Event(need, Some(key(KeyCode::Char(c), mods)))
+            Step::Event(need, Some(key(Press::Char(c))))
         }
         Err(_) => Step::Event(1, None),
     }
@@ -186,31 +174,28 @@ fn parse_escape(b: &[u8]) -> Step {
         b'[' => parse_csi(b),
         b'O' => match b.get(2) {
             None => Step::Incomplete,
-            Some(&f) => Step::Event(3, arrow(f).map(|k| key(k, KeyModifiers::NONE))),
+            Some(&f) => Step::Event(3, arrow(f).map(key)),
         },
         // OSC, DCS, APC, PM, SOS: strings ended by BEL or ESC \.
         b']' | b'P' | b'_' | b'^' | b'X' => parse_string(b),
         // Esc then a control (Esc, Ctrl-C …): the first was the Esc key.
-        0x00..=0x1f | 0x7f => Step::Event(1, Some(key(KeyCode::Esc, KeyModifiers::NONE))),
-        // Alt + a character.
+        0x00..=0x1f | 0x7f => Step::Event(1, Some(key(Press::Esc))),
+        // Alt + a character reads as the character.
         _ => match parse_char(&b[1..]) {
-            Step::Event(n, Some(Input::Key(k))) => {
-                Step::Event(1 + n, Some(key(k.code, k.modifiers | KeyModifiers::ALT)))
-            }
-            Step::Event(n, _) => Step::Event(1 + n, None),
+            Step::Event(n, ev) => Step::Event(1 + n, ev),
             Step::Incomplete => Step::Incomplete,
         },
     }
 }
 
-fn arrow(f: u8) -> Option<KeyCode> {
+/// The arrow a final byte names; Home (`H`) and End (`F`) are read and
+/// dropped.
+fn arrow(f: u8) -> Option<Press> {
     Some(match f {
-        b'A' => KeyCode::Up,
-        b'B' => KeyCode::Down,
-        b'C' => KeyCode::Right,
-        b'D' => KeyCode::Left,
-        b'H' => KeyCode::Home,
-        b'F' => KeyCode::End,
+        b'A' => Press::Up,
+        b'B' => Press::Down,
+        b'C' => Press::Right,
+        b'D' => Press::Left,
         _ => return None,
     })
 }
@@ -242,8 +227,9 @@ fn parse_csi(b: &[u8]) -> Step {
     let first = nums.first().copied().unwrap_or(0);
     let ev = match fin {
         b'A' | b'B' | b'C' | b'D' | b'H' | b'F' if !params.starts_with(['<', '?', '>']) => {
-            let mods = nums.get(1).map_or(KeyModifiers::NONE, |&m| modifiers(m));
-            arrow(fin).map(|k| key(k, mods))
+            // Control + arrow is no key of the table; Shift and Alt are.
+            let ctrl = nums.get(1).is_some_and(|&m| control_held(m));
+            arrow(fin).filter(|_| !ctrl).map(key)
         }
         b'n' if params == "0" => Some(Input::StatusOk),
         b'R' if nums.len() == 2 && !params.starts_with('?') => {
@@ -257,20 +243,10 @@ fn parse_csi(b: &[u8]) -> Step {
     Step::Event(n, ev)
 }
 
-/// xterm's modifier parameter: 1 + (shift 1, alt 2, ctrl 4).
-fn modifiers(m: u16) -> KeyModifiers {
-    let bits = m.saturating_sub(1);
-    let mut k = KeyModifiers::NONE;
-    if bits & 1 != 0 {
-        k |= KeyModifiers::SHIFT;
-    }
-    if bits & 2 != 0 {
-        k |= KeyModifiers::ALT;
-    }
-    if bits & 4 != 0 {
-        k |= KeyModifiers::CONTROL;
-    }
-    k
+/// Whether xterm's modifier parameter, 1 + (shift 1, alt 2, ctrl 4), has
+/// Control.
+fn control_held(m: u16) -> bool {
+    m.saturating_sub(1) & 4 != 0
 }
 
 /// A string sequence, ended by BEL or ST (`ESC \`).
@@ -308,31 +284,14 @@ mod tests {
     }
 
     fn k(c: char) -> Input {
-        let mods = if c.is_uppercase() {
-            KeyModifiers::SHIFT
-        } else {
-            KeyModifiers::NONE
-        };
-        key(KeyCode::Char(c), mods)
-    }
-
-    fn code(c: KeyCode, m: KeyModifiers) -> Input {
-        key(c, m)
+        key(Press::Char(c))
     }
 
     #[test]
     fn printable_utf8_and_controls() {
         assert_eq!(
             parse(&[b"vP] \x03\r\x7f"]),
-            vec![
-                k('v'),
-                k('P'),
-                k(']'),
-                k(' '),
-                code(KeyCode::Char('c'), KeyModifiers::CONTROL),
-                code(KeyCode::Enter, KeyModifiers::NONE),
-                code(KeyCode::Backspace, KeyModifiers::NONE),
-            ]
+            vec![k('v'), k('P'), k(']'), k(' '), key(Press::Ctrl('c')),]
         );
         assert_eq!(parse(&["é→".as_bytes()]), vec![k('é'), k('→')]);
     }
@@ -345,25 +304,16 @@ mod tests {
         assert!(out.is_empty());
         assert!(p.escape_pending());
         p.flush_escape(&mut out);
-        assert_eq!(out, vec![code(KeyCode::Esc, KeyModifiers::NONE)]);
+        assert_eq!(out, vec![key(Press::Esc)]);
         assert!(!p.escape_pending());
         assert_eq!(
             parse(&[b"\x1b\x1b"]),
-            vec![
-                code(KeyCode::Esc, KeyModifiers::NONE),
-                code(KeyCode::Esc, KeyModifiers::NONE)
-            ]
+            vec![key(Press::Esc), key(Press::Esc)]
         );
-        assert_eq!(
-            parse(&[b"\x1bv"]),
-            vec![code(KeyCode::Char('v'), KeyModifiers::ALT)]
-        );
+        assert_eq!(parse(&[b"\x1bv"]), vec![k('v')]);
         assert_eq!(
             parse(&[b"\x1b\x03"]),
-            vec![
-                code(KeyCode::Esc, KeyModifiers::NONE),
-                code(KeyCode::Char('c'), KeyModifiers::CONTROL)
-            ]
+            vec![key(Press::Esc), key(Press::Ctrl('c'))]
         );
     }
 
@@ -371,13 +321,7 @@ mod tests {
     fn arrows_csi_ss3_and_modifiers() {
         assert_eq!(
             parse(&[b"\x1b[A\x1bOB\x1b[1;5C\x1b[1;2D\x1b[H"]),
-            vec![
-                code(KeyCode::Up, KeyModifiers::NONE),
-                code(KeyCode::Down, KeyModifiers::NONE),
-                code(KeyCode::Right, KeyModifiers::CONTROL),
-                code(KeyCode::Left, KeyModifiers::SHIFT),
-                code(KeyCode::Home, KeyModifiers::NONE),
-            ]
+            vec![key(Press::Up), key(Press::Down), key(Press::Left),]
         );
     }
 
@@ -414,11 +358,10 @@ mod tests {
             want,
             vec![
                 k('a'),
-                code(KeyCode::Up, KeyModifiers::CONTROL),
                 Input::StatusOk,
                 Input::Paste(6),
                 k('é'),
-                code(KeyCode::Right, KeyModifiers::NONE),
+                key(Press::Right),
                 k(']'),
             ]
         );
