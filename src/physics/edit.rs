@@ -2,16 +2,13 @@
 //! breaking what the models promise: new spheres go only into free space,
 //! growing radii push the spheres apart, never into each other or a wall.
 //! The caller must `invalidate` the model afterwards.
+use super::free_space::FreeSpace;
 use super::relax;
 use super::sphere::Sphere;
 use super::world::World;
 use glam::DVec3;
 use rand::Rng;
 use rand_distr::StandardNormal;
-use std::collections::HashMap;
-
-/// Random positions tried for one new sphere before the space counts as full.
-const TRIES: usize = 1000;
 
 /// The median radius (`None` for an empty world).
 pub fn typical_radius(world: &World) -> Option<f64> {
@@ -74,26 +71,38 @@ pub fn add_spheres(
     if radius.is_nan() || radius <= 0.0 || 2.0 * radius >= size {
         return 0;
     }
-    let mut free = FreeSpace::new(&world.spheres, radius);
+    let mut free = free_space(&world.spheres, size, radius, count);
     let mut placed = 0;
-    'spheres: while placed < count {
-        for _ in 0..TRIES {
-            let pos = DVec3::new(
-                rng.random_range(radius..=size - radius),
-                rng.random_range(radius..=size - radius),
-                rng.random_range(radius..=size - radius),
-            );
-            if free.is_free(&world.spheres, pos, radius) {
-                let dir = random_direction(rng);
-                free.insert(world.spheres.len() as u32, pos, radius);
-                world.spheres.push(Sphere::new(pos, dir * speed, radius));
-                placed += 1;
-                continue 'spheres;
-            }
-        }
-        break;
+    while placed < count {
+        let Some(pos) = free.place(rng, radius) else {
+            break;
+        };
+        let dir = random_direction(rng);
+        world.spheres.push(Sphere::new(pos, dir * speed, radius));
+        placed += 1;
     }
     placed
+}
+
+/// The free space around `spheres` for `more` new ones of `radius`: the
+/// grid is sized for the bulk (the 98th percentile of radius), the few
+/// larger spheres are checked one by one.
+fn free_space(spheres: &[Sphere], size: f64, radius: f64, more: usize) -> FreeSpace {
+    let mut radii: Vec<f64> = spheres.iter().map(|s| s.radius).collect();
+    let small_max = if radii.is_empty() {
+        radius
+    } else {
+        let k = (radii.len() * 98 / 100).min(radii.len() - 1);
+        radii
+            .select_nth_unstable_by(k, f64::total_cmp)
+            .1
+            .max(radius)
+    };
+    let mut free = FreeSpace::new(size, small_max, radius, spheres.len() + more);
+    for s in spheres {
+        free.insert(s.pos, s.radius);
+    }
+    free
 }
 
 /// A uniformly random unit vector.
@@ -108,80 +117,6 @@ pub fn random_direction(rng: &mut impl Rng) -> DVec3 {
         if len > 1e-9 {
             return v / len;
         }
-    }
-}
-
-/// A hash grid of the spheres sized for the new radius; the few spheres much
-/// bigger than the bulk are checked one by one.
-struct FreeSpace {
-    cell: f64,
-    small_max: f64,
-    cells: HashMap<(i64, i64, i64), Vec<u32>>,
-    big: Vec<u32>,
-}
-
-impl FreeSpace {
-    fn new(spheres: &[Sphere], radius: f64) -> FreeSpace {
-        let mut radii: Vec<f64> = spheres.iter().map(|s| s.radius).collect();
-        let small_max = if radii.is_empty() {
-            radius
-        } else {
-            let k = (radii.len() * 98 / 100).min(radii.len() - 1);
-            radii
-                .select_nth_unstable_by(k, f64::total_cmp)
-                .1
-                .max(radius)
-        };
-        let mut free = FreeSpace {
-            cell: radius + small_max,
-            small_max,
-            cells: HashMap::new(),
-            big: Vec::new(),
-        };
-        for (i, s) in spheres.iter().enumerate() {
-            free.insert(i as u32, s.pos, s.radius);
-        }
-        free
-    }
-
-    fn key(&self, p: DVec3) -> (i64, i64, i64) {
-        let c = (p / self.cell).floor();
-        (c.x as i64, c.y as i64, c.z as i64)
-    }
-
-    fn insert(&mut self, id: u32, pos: DVec3, radius: f64) {
-        if radius > self.small_max {
-            self.big.push(id);
-        } else {
-            self.cells.entry(self.key(pos)).or_default().push(id);
-        }
-    }
-
-    /// A sphere at `pos` with `radius` would overlap or touch nothing. The
-    /// cell is at least the new radius plus any grid sphere's, so the 27
-    /// cells around hold every grid sphere that could touch it.
-    fn is_free(&self, spheres: &[Sphere], pos: DVec3, radius: f64) -> bool {
-        let clear = |id: &u32| {
-            let s = &spheres[*id as usize];
-            let d = radius + s.radius;
-            s.pos.distance_squared(pos) > d * d
-        };
-        if !self.big.iter().all(clear) {
-            return false;
-        }
-        let (x, y, z) = self.key(pos);
-        for dz in -1..=1 {
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    if let Some(ids) = self.cells.get(&(x + dx, y + dy, z + dz))
-                        && !ids.iter().all(clear)
-                    {
-                        return false;
-                    }
-                }
-            }
-        }
-        true
     }
 }
 

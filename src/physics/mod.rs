@@ -9,6 +9,7 @@ pub mod edit;
 pub mod exact;
 pub mod exec;
 pub mod flight;
+pub mod free_space;
 pub mod model;
 pub mod reference;
 pub mod relax;

@@ -3,6 +3,7 @@ use super::presets::{Layout, Preset};
 use crate::bad;
 use crate::error::BadInput;
 use crate::physics::edit::random_direction;
+use crate::physics::free_space::FreeSpace;
 use crate::physics::sphere::volume;
 use crate::physics::{Sphere, World};
 use glam::DVec3;
@@ -10,16 +11,12 @@ use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
 use rand_xoshiro::Xoshiro256PlusPlus;
-use std::collections::HashMap;
 
 pub type SceneRng = Xoshiro256PlusPlus;
 
 pub fn rng(seed: u64) -> SceneRng {
     Xoshiro256PlusPlus::seed_from_u64(seed)
 }
-
-/// Random tries per sphere before random placement gives up.
-const TRIES: usize = 2000;
 
 /// Build the spheres of `preset` with the given (already validated) values.
 pub fn generate(
@@ -116,11 +113,8 @@ fn random_or_lattice(
     }
 }
 
-/// The end of a cell's list of spheres in `random`.
-const NO_SPHERE: u32 = u32::MAX;
-
-/// Random sequential placement with a hash grid; `None` when a sphere finds
-/// no free spot in `TRIES` tries.
+/// Random sequential placement; `None` when a sphere finds no free spot in
+/// [`TRIES`](crate::physics::free_space::TRIES) tries.
 fn random(radii: &[f64], size: f64, rng: &mut SceneRng) -> Option<Vec<(DVec3, f64)>> {
     let rmax = radii.iter().copied().fold(0.0, f64::max);
     if radii.is_empty() {
@@ -129,56 +123,11 @@ fn random(radii: &[f64], size: f64, rng: &mut SceneRng) -> Option<Vec<(DVec3, f6
     if 2.0 * rmax >= size {
         return None;
     }
-    // At least 1/2^20 of the box, so a cell index never saturates (all
-    // spheres in one cell would make placement quadratic).
-    let cell = (2.0 * rmax).max(size / f64::from(1u32 << 20));
-    let key = |p: DVec3| (p / cell).floor().as_ivec3().to_array();
-    // Each cell's spheres as a list threaded through `next` (the cell keeps
-    // its last one): about 40 bytes a sphere, where a `Vec` per cell took
-    // about 160 (a million spheres took more memory to place than to step).
-    let mut last: HashMap<[i32; 3], u32> = HashMap::with_capacity(radii.len());
-    let mut next: Vec<u32> = Vec::with_capacity(radii.len());
-    let mut out: Vec<(DVec3, f64)> = Vec::with_capacity(radii.len());
+    let mut free = FreeSpace::new(size, rmax, rmax, radii.len());
     for &r in radii {
-        let mut placed = false;
-        for _ in 0..TRIES {
-            let p = DVec3::new(
-                rng.random_range(r..=size - r),
-                rng.random_range(r..=size - r),
-                rng.random_range(r..=size - r),
-            );
-            let k = key(p);
-            let free = (-1..=1).all(|dx| {
-                (-1..=1).all(|dy| {
-                    (-1..=1).all(|dz| {
-                        let mut j = last
-                            .get(&[k[0] + dx, k[1] + dy, k[2] + dz])
-                            .map_or(NO_SPHERE, |&j| j);
-                        while j != NO_SPHERE {
-                            let (q, rq) = out[j as usize];
-                            if p.distance_squared(q) < (r + rq) * (r + rq) {
-                                return false;
-                            }
-                            j = next[j as usize];
-                        }
-                        true
-                    })
-                })
-            });
-            if free {
-                let at = last.entry(k).or_insert(NO_SPHERE);
-                next.push(*at);
-                *at = out.len() as u32;
-                out.push((p, r));
-                placed = true;
-                break;
-            }
-        }
-        if !placed {
-            return None;
-        }
+        free.place(rng, r)?;
     }
-    Some(out)
+    Some(free.into_placed())
 }
 
 /// A cubic lattice over the whole box, `k = ⌈∛n⌉` sites a side (the
