@@ -11,7 +11,7 @@ use ballpit::tui::app::{self, View};
 use ballpit::tui::canvas::{DrawStyle, Raster};
 use ballpit::tui::keys::TABLE;
 use ballpit::tui::readouts::{NOTICE_ROWS, Readouts, Stats};
-use ballpit::tui::state::{AppState, FPS_STEPS, MAX_COUNT, MAX_TICK, MIN_RADIUS};
+use ballpit::tui::state::{AppState, FPS_STEPS, MAX_KEY_COUNT, MAX_TICK, MIN_RADIUS};
 use ballpit::tui::theme::Palette;
 use ballpit::tui::threads;
 use glam::DVec3;
@@ -65,8 +65,8 @@ fn states() -> Vec<AppState> {
                         (flags & 1 != 0, flags & 2 != 0, flags & 4 != 0);
                     (st.threads, st.tick, st.count, st.radius, st.fps) = match limit {
                         0 => (1, 0, 1, MIN_RADIUS * 1.1, FPS_STEPS[0]),
-                        1 => (MAX_THREADS, MAX_TICK, MAX_COUNT, 1.0, FPS_STEPS[6]),
-                        _ => (MAX_THREADS - 1, MAX_TICK - 1, MAX_COUNT / 2, 0.5, 60.0),
+                        1 => (MAX_THREADS, MAX_TICK, MAX_KEY_COUNT, 1.0, FPS_STEPS[6]),
+                        _ => (MAX_THREADS - 1, MAX_TICK - 1, MAX_KEY_COUNT / 2, 0.5, 60.0),
                     };
                     st.style = if limit == 2 {
                         DrawStyle::Shaded
@@ -121,13 +121,13 @@ fn engine_notices() -> Vec<String> {
     let mut e = Engine::new(World::new(1.0, big), s).unwrap();
     out.extend(frame(&mut e, Command::SetCount(1000)));
     // The widest count figures: a million spheres kept, two million asked.
-    let many = vec![Sphere::new(DVec3::splat(0.5), DVec3::X, 0.6); MAX_COUNT / 2 + 1];
+    let many = vec![Sphere::new(DVec3::splat(0.5), DVec3::X, 0.6); MAX_KEY_COUNT / 2 + 1];
     let mut w = World::new(1.0, many);
     let mut rng = rand::rngs::StdRng::seed_from_u64(1);
-    out.extend(edit::set_count(&mut w, MAX_COUNT, 0.6, 1.0, &mut rng));
-    let need = ballpit::memory::need(MAX_COUNT, None);
+    out.extend(edit::set_count(&mut w, MAX_KEY_COUNT, 0.6, 1.0, &mut rng));
+    let need = ballpit::memory::need(MAX_KEY_COUNT, None);
     for free in [0, 100 << 20, need - 1] {
-        out.extend(ballpit::memory::count_notice(MAX_COUNT, Some(free)));
+        out.extend(ballpit::memory::count_notice(MAX_KEY_COUNT, Some(free)));
     }
     // Threads the system refused while running, and what runs instead.
     let refused = ballpit::engine::Refused {

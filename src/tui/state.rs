@@ -9,7 +9,9 @@ use crate::physics::auto::Tolerance;
 
 /// The most steps a frame runs, for `--tick` and the keys alike.
 pub const MAX_TICK: u32 = 1_000_000;
-pub const MAX_COUNT: usize = 1 << 21;
+/// The most spheres the `N` key doubles to (a scene from the command line
+/// may hold more, up to `scene::MAX_COUNT`).
+pub const MAX_KEY_COUNT: usize = 1 << 21;
 pub const MIN_RADIUS: f64 = 1e-4;
 /// A count from which placing the spheres takes long enough to say so.
 pub const BIG_EDIT: usize = 100_000;
@@ -269,8 +271,8 @@ impl AppState {
                 }
             }
             Action::DoubleCount => {
-                if self.count * 2 > MAX_COUNT {
-                    self.notice = Some(format!("count limit: {MAX_COUNT}"));
+                if self.count * 2 > MAX_KEY_COUNT {
+                    self.notice = Some(format!("count limit: {MAX_KEY_COUNT}"));
                 } else {
                     self.count = (self.count * 2).max(1);
                     out.push(Command::SetCount(self.count));
