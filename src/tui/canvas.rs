@@ -7,10 +7,10 @@ use crate::engine::SphereView;
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
 use ratatui::style::Color;
-use strum::{EnumIter, IntoEnumIterator, IntoStaticStr};
+use strum::IntoStaticStr;
 
 /// `v` cycles these.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, EnumIter, IntoStaticStr)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, IntoStaticStr)]
 pub enum DrawStyle {
     /// Braille dots (2×4 per cell), one colour per cell, coloured by speed.
     #[strum(serialize = "braille, speed")]
@@ -24,14 +24,15 @@ pub enum DrawStyle {
 }
 
 impl DrawStyle {
-    /// The `v` key's cycle, in the order of declaration.
+    /// The `v` key's cycle, in the order of declaration (a match, as every
+    /// cycle of keys is written: the compiler sees a style left out).
     #[must_use]
     pub fn next(self) -> DrawStyle {
-        DrawStyle::iter()
-            .cycle()
-            .skip_while(|&s| s != self)
-            .nth(1)
-            .unwrap_or(self)
+        match self {
+            DrawStyle::PointsSpeed => DrawStyle::PointsDepth,
+            DrawStyle::PointsDepth => DrawStyle::Shaded,
+            DrawStyle::Shaded => DrawStyle::PointsSpeed,
+        }
     }
 
     pub fn name(self) -> &'static str {
