@@ -2,6 +2,7 @@
 //! It knows nothing of threads (it is handed an [`exec::Exec`]) or terminals.
 pub mod auto;
 pub mod broad;
+mod build;
 pub mod contact;
 mod detect;
 pub mod discrete;

@@ -76,15 +76,6 @@ impl ModelKind {
             _ => None,
         }
     }
-
-    pub fn build(self) -> Box<dyn Model> {
-        match self {
-            ModelKind::Discrete => Box::new(super::discrete::Discrete::default()),
-            ModelKind::Swept => Box::new(super::swept::Swept::default()),
-            ModelKind::Exact => Box::new(super::exact::Exact::default()),
-            ModelKind::Auto(t) => Box::new(super::auto::Auto::new(t)),
-        }
-    }
 }
 
 /// A collision model. It may keep state between calls (schedules, grids); it
