@@ -14,8 +14,8 @@
 //! wakes the other `L - 1` threads and no others.
 use crate::physics::Exec;
 use crate::physics::exec::{Bound, Busy};
-use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
-use std::sync::mpsc;
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, mpsc};
 use std::time::Instant;
 
 /// Data decomposition: `K` threads `pool-0..K-1`, at most one lane a core.
@@ -99,39 +99,61 @@ impl PoolExec {
     }
 }
 
-/// The threads beyond the cores: each blocks on a channel of its own
-/// that no one sends on, so it takes no CPU, and ends when the pool drops
-/// the sender (a refusal part way through ends the ones started).
+/// The threads beyond the cores: each parks until the pool is dropped, so
+/// it takes no CPU. They allocate nothing once started (a preallocated
+/// channel, `gettid`, `park`): at the edge of `ulimit -v` a refused start
+/// stays a refusal, never an aborted allocation in a thread that did start.
 struct Spare {
-    _stops: Vec<mpsc::Sender<()>>,
+    stop: Arc<AtomicBool>,
+    handles: Vec<std::thread::JoinHandle<()>>,
     tids: Vec<(String, i32)>,
 }
 
 impl Spare {
     fn start(from: usize, to: usize) -> std::io::Result<Spare> {
-        let (told, tids) = mpsc::channel();
-        let mut stops = Vec::with_capacity(to.saturating_sub(from));
+        let n = to.saturating_sub(from);
+        let (told, heard) = mpsc::sync_channel(n);
+        let mut spare = Spare {
+            stop: Arc::new(AtomicBool::new(false)),
+            handles: Vec::with_capacity(n),
+            tids: Vec::with_capacity(n),
+        };
         for i in from..to {
-            let (stop, wait) = mpsc::channel::<()>();
-            let told = told.clone();
-            let name = format!("pool-{i}");
-            std::thread::Builder::new()
-                .name(name.clone())
+            let (told, stop) = (told.clone(), spare.stop.clone());
+            let spawned = std::thread::Builder::new()
+                .name(format!("pool-{i}"))
                 .spawn(move || {
-                    let _ = told.send(crate::cpu::current_tid().map(|t| (i, name, t)));
+                    let _ = told.send((i, crate::cpu::current_tid()));
                     drop(told);
-                    let _ = wait.recv();
-                })?;
-            stops.push(stop);
+                    while !stop.load(Ordering::Acquire) {
+                        std::thread::park();
+                    }
+                });
+            // On a refusal `spare` drops: the started threads end and give
+            // their stacks back before the refusal is reported.
+            spare.handles.push(spawned?);
         }
         drop(told);
-        // Every thread sends once, then drops its sender: this ends.
-        let mut tids: Vec<(usize, String, i32)> = tids.iter().flatten().collect();
+        let mut tids: Vec<(usize, i32)> = heard
+            .iter()
+            .filter_map(|(i, tid)| tid.map(|t| (i, t)))
+            .collect();
         tids.sort_unstable_by_key(|t| t.0);
-        Ok(Spare {
-            _stops: stops,
-            tids: tids.into_iter().map(|(_, name, tid)| (name, tid)).collect(),
-        })
+        spare.tids = tids
+            .into_iter()
+            .map(|(i, tid)| (format!("pool-{i}"), tid))
+            .collect();
+        Ok(spare)
+    }
+}
+
+impl Drop for Spare {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Release);
+        for h in self.handles.drain(..) {
+            h.thread().unpark();
+            let _ = h.join();
+        }
     }
 }
 
