@@ -62,3 +62,42 @@ fn threads_beyond_the_lanes_take_no_cpu() {
         "the 254 threads without a lane took {beyond:.3} s of {total:.3} s (lanes {lanes:.3} s)"
     );
 }
+
+/// Every lane of a section runs once, whether it has fewer lanes than the
+/// pool's lane threads (jobs), as many (a broadcast) or more (lane `i`
+/// and `i + L`, … on `pool-i`); and every thread of the pool is listed,
+/// in order, whichever part it is in.
+#[test]
+fn every_lane_runs_once_and_every_thread_is_listed() {
+    use ballpit::engine::PoolExec;
+    use ballpit::physics::Exec;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    for (threads, cores) in [(8, 8), (256, 2), (3, 1), (5, 64)] {
+        let pool = PoolExec::on_cores(threads, cores).unwrap();
+        assert_eq!(pool.lane_threads(), threads.min(cores));
+        for lanes in [1, 2, 3, 8, 20] {
+            let runs: Vec<AtomicUsize> = (0..lanes).map(|_| AtomicUsize::new(0)).collect();
+            pool.for_lanes(lanes, &|l| {
+                runs[l].fetch_add(1, Ordering::Relaxed);
+            });
+            let runs: Vec<usize> = runs.iter().map(|r| r.load(Ordering::Relaxed)).collect();
+            assert_eq!(
+                runs,
+                vec![1; lanes],
+                "{threads} on {cores} cores, {lanes} lanes"
+            );
+        }
+        let ids = pool.thread_ids();
+        #[cfg(target_os = "linux")]
+        {
+            let names: Vec<String> = ids.iter().map(|t| t.0.clone()).collect();
+            let want: Vec<String> = (0..threads).map(|i| format!("pool-{i}")).collect();
+            assert_eq!(names, want);
+            let mut tids: Vec<i32> = ids.iter().map(|t| t.1).collect();
+            tids.sort_unstable();
+            tids.dedup();
+            assert_eq!(tids.len(), threads, "one id a thread");
+        }
+        drop(ids);
+    }
+}
