@@ -1,16 +1,32 @@
-//! The `pool` and `split` executors: rayon pools of named threads. Rayon's
-//! idle threads spin for a few dozen yields and then sleep on a condition
-//! variable, so a pool that is not in use costs no CPU. A section of `k`
-//! lanes hands out `k - 1` jobs and runs one itself, so it wakes at most
-//! `k - 1` threads: a pool of 256 running work for one lane wakes none.
+//! The `pool` and `split` executors: rayon pools of named threads.
+//!
+//! A pool of `K` threads on `C` cores runs its lanes on a rayon pool of
+//! `L = min(K, C)` threads, `pool-0..L-1`; the lane rule (`lanes_for`)
+//! never gives a section more than `L` lanes, so threads beyond the cores
+//! could never help. They are started all the same, `pool-L..K-1`, as real
+//! threads that block until the pool ends: the user asked for `K`, the
+//! panel shows them (idle, no CPU) and the system's refusal of one still
+//! counts. Were they in the rayon pool, every woken rayon thread that finds
+//! work wakes another sleeping one (`Sleep::work_found`) and spins 32
+//! yields before sleeping again: with 256 threads on 2 cores each section
+//! set off a chain of wakes (4.4x slower than worker at 10k spheres).
+//! A section of all `L` lanes is a broadcast, lane `i` on `pool-i`, which
+//! wakes the other `L - 1` threads and no others.
 use crate::physics::Exec;
 use crate::physics::exec::{Bound, Busy};
-use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, mpsc};
 use std::time::Instant;
 
 /// Data decomposition: `K` threads `pool-0..K-1`, at most one lane a core.
 pub struct PoolExec {
+    /// `pool-0..L-1`, the threads that run lanes.
     pool: rayon::ThreadPool,
+    /// `pool-L..K-1`, blocked until the pool is dropped.
+    _spare: Spare,
+    /// `(name, tid)` of all `K`, read once at start (asking a rayon pool
+    /// again would wake every thread).
+    tids: Vec<(String, i32)>,
     threads: usize,
     cores: usize,
     /// The widest section since `take_busy`, and what bound it (`Bound` as
@@ -26,17 +42,34 @@ impl PoolExec {
     /// # Errors
     /// When the system refuses a thread (`ulimit -u`, `ulimit -v`).
     pub fn new(threads: usize) -> Result<PoolExec, Refused> {
+        let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
+        PoolExec::on_cores(threads, cores)
+    }
+
+    /// A pool of `threads` as if the machine had `cores` cores (tests of a
+    /// machine wider than this one).
+    ///
+    /// # Errors
+    /// When the system refuses a thread (`ulimit -u`, `ulimit -v`).
+    pub fn on_cores(threads: usize, cores: usize) -> Result<PoolExec, Refused> {
         let threads = threads.max(1);
+        let cores = cores.max(1);
+        let what = || format!("{threads} pool threads");
         // The build error's text is its cause's, and its source that cause
         // again: say it once, as bad input (exit 2), naming what failed.
         let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
+            .num_threads(threads.min(cores))
             .thread_name(|i| format!("pool-{i}"))
             .build()
-            .map_err(|e| Refused::new(format!("{threads} pool threads"), &e))?;
-        let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
+            .map_err(|e| Refused::new(what(), e.to_string()))?;
+        let spare = Spare::start(threads.min(cores), threads)
+            .map_err(|e| Refused::new(what(), e.to_string()))?;
+        let mut tids = thread_ids(&pool);
+        tids.extend(spare.tids.iter().cloned());
         Ok(PoolExec {
             pool,
+            _spare: spare,
+            tids,
             threads,
             cores,
             busy: AtomicUsize::new(0),
@@ -54,9 +87,73 @@ impl PoolExec {
         self.threads
     }
 
+    /// How many of the threads can run lanes (`min(threads, cores)`); the
+    /// rest wait without a lane.
+    pub fn lane_threads(&self) -> usize {
+        self.pool.current_num_threads()
+    }
+
     /// `(name, kernel thread id)` of every pool thread (Linux).
     pub fn thread_ids(&self) -> Vec<(String, i32)> {
-        thread_ids(&self.pool)
+        self.tids.clone()
+    }
+}
+
+/// The threads beyond the cores: each parks until the pool is dropped, so
+/// it takes no CPU. They allocate nothing once started (a preallocated
+/// channel, `gettid`, `park`): at the edge of `ulimit -v` a refused start
+/// stays a refusal, never an aborted allocation in a thread that did start.
+struct Spare {
+    stop: Arc<AtomicBool>,
+    handles: Vec<std::thread::JoinHandle<()>>,
+    tids: Vec<(String, i32)>,
+}
+
+impl Spare {
+    fn start(from: usize, to: usize) -> std::io::Result<Spare> {
+        let n = to.saturating_sub(from);
+        let (told, heard) = mpsc::sync_channel(n);
+        let mut spare = Spare {
+            stop: Arc::new(AtomicBool::new(false)),
+            handles: Vec::with_capacity(n),
+            tids: Vec::with_capacity(n),
+        };
+        for i in from..to {
+            let (told, stop) = (told.clone(), spare.stop.clone());
+            let spawned = std::thread::Builder::new()
+                .name(format!("pool-{i}"))
+                .spawn(move || {
+                    let _ = told.send((i, crate::cpu::current_tid()));
+                    drop(told);
+                    while !stop.load(Ordering::Acquire) {
+                        std::thread::park();
+                    }
+                });
+            // On a refusal `spare` drops: the started threads end and give
+            // their stacks back before the refusal is reported.
+            spare.handles.push(spawned?);
+        }
+        drop(told);
+        let mut tids: Vec<(usize, i32)> = heard
+            .iter()
+            .filter_map(|(i, tid)| tid.map(|t| (i, t)))
+            .collect();
+        tids.sort_unstable_by_key(|t| t.0);
+        spare.tids = tids
+            .into_iter()
+            .map(|(i, tid)| (format!("pool-{i}"), tid))
+            .collect();
+        Ok(spare)
+    }
+}
+
+impl Drop for Spare {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Release);
+        for h in self.handles.drain(..) {
+            h.thread().unpark();
+            let _ = h.join();
+        }
     }
 }
 
@@ -72,11 +169,8 @@ pub struct Refused {
 }
 
 impl Refused {
-    fn new(what: String, e: &rayon::ThreadPoolBuildError) -> Refused {
-        Refused {
-            what,
-            cause: e.to_string(),
-        }
+    fn new(what: String, cause: String) -> Refused {
+        Refused { what, cause }
     }
 }
 
@@ -155,15 +249,25 @@ impl Exec for PoolExec {
             f(0);
             return;
         }
-        // Lane 0 on the caller, the others as jobs the idle threads steal;
-        // a panic in any comes back here.
         let t0 = Instant::now();
-        self.pool.in_place_scope(|s| {
-            for lane in 1..lanes.min(self.threads) {
-                s.spawn(move |_| f(lane));
-            }
-            f(0);
-        });
+        let width = self.lane_threads();
+        if lanes >= width {
+            // Lane `i` (and `i + L`, … past `L` lanes) on `pool-i`: the
+            // other `L - 1` threads wake, and no others; a panic in any
+            // comes back here.
+            self.pool.broadcast(|ctx| {
+                (ctx.index()..lanes).step_by(width).for_each(f);
+            });
+        } else {
+            // Fewer lanes than threads (more than 2 cores): lane 0 on the
+            // caller, the others as jobs the idle threads steal.
+            self.pool.in_place_scope(|s| {
+                for lane in 1..lanes {
+                    s.spawn(move |_| f(lane));
+                }
+                f(0);
+            });
+        }
         let ns = u64::try_from(t0.elapsed().as_nanos()).unwrap_or(u64::MAX);
         self.parallel_ns.fetch_add(ns, Ordering::Relaxed);
     }
@@ -218,7 +322,7 @@ impl SplitExec {
             .num_threads(2)
             .thread_name(|i| SPLIT_NAMES[i].to_string())
             .build()
-            .map_err(|e| Refused::new("the two split threads".into(), &e))?;
+            .map_err(|e| Refused::new("the two split threads".into(), e.to_string()))?;
         Ok(SplitExec { pool })
     }
 
