@@ -9,7 +9,7 @@
 //!
 //! With a size, pool and view it draws only that one (for callgrind: the
 //! difference between two frame counts is the cost of the frames).
-use ballpit::cpu::{CpuReport, ThreadLoad};
+use ballpit::cpu::{CpuReport, ThreadLoad, ThreadRole};
 use ballpit::engine::{Engine, Settings, Threading};
 use ballpit::physics::ModelKind;
 use ballpit::tui::app::{self, View};
@@ -32,6 +32,7 @@ fn report(pool: usize) -> CpuReport {
             let history: Vec<f64> = (0..60).map(|s| ((i * 37 + s * 7) % 101) as f64).collect();
             ThreadLoad {
                 tid: i as i32 + 1,
+                role: ThreadRole::of(&name),
                 name,
                 percent: history[59],
                 cpu_seconds: 1.0,

@@ -2,7 +2,7 @@
 //! draws at: read back from the drawn screen, each binding's keys and its
 //! description, in the table's order, in one column or two.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
-use ballpit::cpu::{CpuReport, ThreadLoad};
+use ballpit::cpu::{CpuReport, ThreadLoad, ThreadRole};
 use ballpit::engine::{Engine, Settings, Threading};
 use ballpit::physics::{ModelKind, Sphere, World};
 use ballpit::tui::app::{self, MIN_HEIGHT, MIN_WIDTH, View};
@@ -34,6 +34,7 @@ fn screen(w: u16, h: u16) -> Vec<Vec<char>> {
         threads: ["main", "physics"]
             .map(|name| ThreadLoad {
                 tid: 1,
+                role: ThreadRole::of(name),
                 name: name.into(),
                 percent: 10.0,
                 cpu_seconds: 1.0,

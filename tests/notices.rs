@@ -4,7 +4,7 @@
 //! key of the key table pressed in many states, the engine's edits and
 //! resets, the memory check's screen form, the pause and the event cap.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
-use ballpit::cpu::{CpuReport, ThreadLoad};
+use ballpit::cpu::{CpuReport, ThreadLoad, ThreadRole};
 use ballpit::engine::{Command, Engine, MAX_THREADS, Settings, Snapshot, Threading};
 use ballpit::physics::{ModelKind, Sphere, World, edit};
 use ballpit::tui::app::{self, View};
@@ -218,6 +218,7 @@ fn report(mode: Threading, pool: usize) -> CpuReport {
         .zip(names)
         .map(|(i, name)| ThreadLoad {
             tid: 100 + i32::try_from(i).unwrap(),
+            role: ThreadRole::of(&name),
             name,
             percent: 1.0 + (i % 7) as f64,
             cpu_seconds: 1.0,

@@ -3,7 +3,7 @@
 //! every figure with its `%` and base, the pool's own total, and the grid
 //! only where the rows run out.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
-use ballpit::cpu::{CpuReport, ThreadLoad};
+use ballpit::cpu::{CpuReport, ThreadLoad, ThreadRole};
 use ballpit::tui::app;
 use ballpit::tui::theme::Palette;
 use ballpit::tui::threads::{self, Layout, Threads};
@@ -22,6 +22,7 @@ fn report(pool: usize) -> CpuReport {
             .collect();
         threads.push(ThreadLoad {
             tid,
+            role: ThreadRole::of(&name),
             name,
             percent,
             cpu_seconds: 1.0,

@@ -1,6 +1,6 @@
 //! The screen parts at a fixed state, drawn on ratatui's `TestBackend`.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
-use ballpit::cpu::{CpuReport, ThreadLoad};
+use ballpit::cpu::{CpuReport, ThreadLoad, ThreadRole};
 use ballpit::engine::{Engine, Settings, Snapshot, Threading};
 use ballpit::physics::{ModelKind, Sphere, World};
 use ballpit::tui::app::{self, View};
@@ -61,6 +61,7 @@ fn stats() -> Stats {
 fn report() -> CpuReport {
     let load = |tid, name: &str, percent, history: Vec<f64>| ThreadLoad {
         tid,
+        role: ThreadRole::of(name),
         name: name.into(),
         percent,
         cpu_seconds: 1.0,
@@ -94,6 +95,7 @@ fn report_for(mode: Threading, pool: usize) -> CpuReport {
                 .collect();
             ThreadLoad {
                 tid: 100 + i as i32,
+                role: ThreadRole::of(&name),
                 name,
                 percent: *history.last().unwrap(),
                 cpu_seconds: 1.0,

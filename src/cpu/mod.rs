@@ -4,7 +4,10 @@
 //! processes take (`machine`). Elsewhere the report holds only the core count.
 pub mod history;
 pub mod machine;
+mod role;
 mod task;
+
+pub use role::ThreadRole;
 
 pub use task::{current_tid, thread_cpu_seconds_of};
 
@@ -18,6 +21,8 @@ use std::time::{Duration, Instant};
 pub struct ThreadLoad {
     pub tid: i32,
     pub name: String,
+    /// What the thread is for, read from its name once.
+    pub role: ThreadRole,
     /// Percent of one core over the sliding window (100 = one core busy).
     pub percent: f64,
     /// Total CPU seconds since the thread started.
@@ -44,6 +49,7 @@ pub const WINDOW: Duration = Duration::from_secs(1);
 
 struct Track {
     name: String,
+    role: ThreadRole,
     /// (when, CPU seconds) samples covering at least the window.
     samples: VecDeque<(Instant, f64)>,
     history: History,
@@ -97,11 +103,17 @@ impl Sampler {
         for (tid, name, secs) in task::read_threads() {
             let t = self.tracks.entry(tid).or_insert_with(|| Track {
                 name: String::new(),
+                role: ThreadRole::Other,
                 samples: VecDeque::new(),
                 history: History::new(origin),
                 seen: false,
             });
-            t.name = name;
+            if t.name != name {
+                // A thread may rename itself (rayon names its threads after
+                // they start): the role follows the name.
+                t.role = ThreadRole::of(&name);
+                t.name = name;
+            }
             t.seen = true;
             t.samples.push_back((now, secs));
             // Keep one sample at least a window old, so the rate spans it.
@@ -126,6 +138,7 @@ impl Sampler {
                 Some(ThreadLoad {
                     tid,
                     name: t.name.clone(),
+                    role: t.role,
                     percent,
                     cpu_seconds: c1,
                     history: t.history.values(),
@@ -148,21 +161,15 @@ impl Sampler {
 }
 
 /// The order every reader shows threads in, stable from frame to frame:
-/// `main`, `physics`, the pool by number, the split's threads, then the
-/// rest by name (and id, for twins).
-pub fn order_key(t: &ThreadLoad) -> (u8, &str, u64, i32) {
-    let numbered = t
-        .name
-        .rsplit_once('-')
-        .and_then(|(p, n)| Some((p, n.parse::<u64>().ok()?)));
-    match (t.name.as_str(), numbered) {
-        ("main", _) => (0, "", 0, t.tid),
-        ("physics", _) => (1, "", 0, t.tid),
-        (_, Some(("pool", n))) => (2, "", n, t.tid),
-        (name, _) if name.starts_with("split") => (3, name, 0, t.tid),
-        (_, Some((p, n))) => (4, p, n, t.tid),
-        (name, None) => (4, name, 0, t.tid),
-    }
+/// by role (`main`, `physics`, the pool by number, the split's threads),
+/// then the rest by name (and id, for twins).
+pub fn order_key(t: &ThreadLoad) -> (ThreadRole, &str, i32) {
+    let name = if t.role == ThreadRole::Other {
+        t.name.as_str()
+    } else {
+        ""
+    };
+    (t.role, name, t.tid)
 }
 
 /// Every thread of the process with its CPU seconds, for the bench JSON.

@@ -1,5 +1,6 @@
 //! Reading thread run times out of `/proc/self/task` (Linux only; other
 //! systems get empty answers).
+use super::ThreadRole;
 use std::fs;
 
 /// `(tid, name, cpu_seconds)` for every thread of the process, by tid. The
@@ -16,7 +17,11 @@ pub fn read_threads() -> Vec<(i32, String, f64)> {
             // A thread may exit between listing and reading: skip it then.
             let secs = thread_cpu_seconds_of(tid)?;
             let name = fs::read_to_string(format!("/proc/self/task/{tid}/comm")).ok()?;
-            let name = if tid == pid { "main" } else { name.trim_end() };
+            let name = if tid == pid {
+                &ThreadRole::Main.name()
+            } else {
+                name.trim_end()
+            };
             Some((tid, name.to_string(), secs))
         })
         .collect();

@@ -20,10 +20,11 @@ mod snapshot;
 mod start;
 mod worker;
 
-pub use pool::{KEPT_WORKER, PoolExec, Refused, SPLIT_NAMES, SplitExec, kept_pool};
+pub use pool::{KEPT_WORKER, PoolExec, Refused, SPLIT_ROLES, SplitExec, kept_pool, pool_name};
 pub use snapshot::{Snapshot, SphereView};
 pub use start::Rebuild;
 
+use crate::cpu::ThreadRole;
 use crate::physics::{Model, ModelKind, Serial, World, edit};
 use frame::{Frame, SharedExec};
 use rand::SeedableRng;
@@ -119,15 +120,17 @@ pub const MAX_THREADS: usize = 256;
 /// executor's lanes, so in `split` it runs on `physics` alone.
 pub fn physics_threads(threading: Threading, threads: usize, model: ModelKind) -> Vec<String> {
     match threading {
-        Threading::Off => {
-            vec![std::thread::current().name().unwrap_or("main").to_string()]
-        }
-        Threading::Pool => (0..threads).map(|i| format!("pool-{i}")).collect(),
-        Threading::Split if !model.runs_on_one_lane() => std::iter::once("physics")
-            .chain(SPLIT_NAMES)
-            .map(String::from)
+        Threading::Off => vec![
+            std::thread::current()
+                .name()
+                .map_or_else(|| ThreadRole::Main.name().into_owned(), String::from),
+        ],
+        Threading::Pool => (0..threads).map(pool_name).collect(),
+        Threading::Split if !model.runs_on_one_lane() => std::iter::once(ThreadRole::Physics)
+            .chain(SPLIT_ROLES)
+            .map(|r| r.name().into_owned())
             .collect(),
-        Threading::Worker | Threading::Split => vec!["physics".to_string()],
+        Threading::Worker | Threading::Split => vec![ThreadRole::Physics.name().into_owned()],
     }
 }
 /// Seeds the placement of spheres added by `SetCount`, so runs repeat.
@@ -378,7 +381,7 @@ impl Engine {
         let split = self.split.iter().flat_map(|s| s.thread_ids());
         self.worker
             .tid()
-            .map(|t| ("physics".to_string(), t))
+            .map(|t| (ThreadRole::Physics.name().into_owned(), t))
             .into_iter()
             .chain(pool)
             .chain(split)

@@ -12,6 +12,7 @@
 //! set off a chain of wakes (4.4x slower than worker at 10k spheres).
 //! A section of all `L` lanes is a broadcast, lane `i` on `pool-i`, which
 //! wakes the other `L - 1` threads and no others.
+use crate::cpu::ThreadRole;
 use crate::physics::Exec;
 use crate::physics::exec::{Bound, Busy};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
@@ -59,7 +60,7 @@ impl PoolExec {
         // again: say it once, as bad input (exit 2), naming what failed.
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads.min(cores))
-            .thread_name(|i| format!("pool-{i}"))
+            .thread_name(pool_name)
             .build()
             .map_err(|e| Refused::new(what(), e.to_string()))?;
         let spare = Spare::start(threads.min(cores), threads)
@@ -121,7 +122,7 @@ impl Spare {
         for i in from..to {
             let (told, stop) = (told.clone(), spare.stop.clone());
             let spawned = std::thread::Builder::new()
-                .name(format!("pool-{i}"))
+                .name(pool_name(i))
                 .spawn(move || {
                     let _ = told.send((i, crate::cpu::current_tid()));
                     drop(told);
@@ -141,7 +142,7 @@ impl Spare {
         tids.sort_unstable_by_key(|t| t.0);
         spare.tids = tids
             .into_iter()
-            .map(|(i, tid)| (format!("pool-{i}"), tid))
+            .map(|(i, tid)| (pool_name(i), tid))
             .collect();
         Ok(spare)
     }
@@ -305,7 +306,14 @@ impl Exec for PoolExec {
 }
 
 /// Names of the `split` threads, by the work they take.
-pub const SPLIT_NAMES: [&str; 2] = ["split-pair", "split-wall"];
+pub const SPLIT_ROLES: [ThreadRole; 2] = [ThreadRole::SplitPair, ThreadRole::SplitWall];
+
+/// Pool thread `i`'s name, from its role.
+pub fn pool_name(i: usize) -> String {
+    ThreadRole::Pool(u32::try_from(i).unwrap_or(u32::MAX))
+        .name()
+        .into_owned()
+}
 
 /// Functional decomposition: `join`'s first job (sphere–sphere work) on
 /// `split-pair`, its second (sphere–wall work) on `split-wall`. Data-parallel
@@ -320,7 +328,7 @@ impl SplitExec {
     pub fn new() -> Result<SplitExec, Refused> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(2)
-            .thread_name(|i| SPLIT_NAMES[i].to_string())
+            .thread_name(|i| SPLIT_ROLES[i].name().into_owned())
             .build()
             .map_err(|e| Refused::new("the two split threads".into(), e.to_string()))?;
         Ok(SplitExec { pool })

@@ -2,6 +2,7 @@
 //! channel until handed a frame, and handing it back on the done channel
 //! (the article's start and done events, carrying the frame with them).
 use super::frame::Frame;
+use crate::cpu::ThreadRole;
 use crossbeam_channel::{Receiver, Sender, bounded};
 use parking_lot::Mutex;
 use std::any::Any;
@@ -30,7 +31,7 @@ impl Worker {
         let notify: Arc<Mutex<Option<Notify>>> = Arc::default();
         let hook = notify.clone();
         let handle = std::thread::Builder::new()
-            .name("physics".into())
+            .name(ThreadRole::Physics.name().into_owned())
             .spawn(move || {
                 let _ = tid_tx.send(crate::cpu::current_tid());
                 while let Ok(frame) = start_rx.recv() {

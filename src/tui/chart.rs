@@ -236,11 +236,12 @@ impl Widget for CpuChart<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cpu::ThreadLoad;
+    use crate::cpu::{ThreadLoad, ThreadRole};
 
     fn load(tid: i32, name: &str, history: Vec<f64>) -> ThreadLoad {
         ThreadLoad {
             tid,
+            role: ThreadRole::of(name),
             name: name.into(),
             percent: history.last().copied().unwrap_or(0.0),
             cpu_seconds: 0.0,

@@ -8,7 +8,7 @@
 //! by load, as btop shows cores, with a legend. No thread is ever left out.
 use super::theme::Palette;
 use crate::cpu::history;
-use crate::cpu::{CpuReport, ThreadLoad, order_key};
+use crate::cpu::{CpuReport, ThreadLoad, ThreadRole, order_key};
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
 use ratatui::style::{Color, Style};
@@ -105,45 +105,20 @@ pub fn cell(percent: f64) -> char {
 /// The grid's legend, the levels `cell` draws.
 pub const LEGEND: &str = "· idle  ▁ under 19 %  ▄ 50 %  █ 100 %";
 
-/// The numbered group (`pool-N`) with the most members, if it has
-/// `min_members` or more, sorted by number; and every other thread, in
-/// report order.
+/// The pool's lane threads, if there are `min_members` or more, by lane;
+/// and every other thread, in report order.
 pub fn group_of(
     report: &CpuReport,
     min_members: usize,
 ) -> (Vec<&ThreadLoad>, Option<(String, Vec<&ThreadLoad>)>) {
-    // `pool-12` -> ("pool", 12); no allocation, as this runs every frame.
-    fn numbered(t: &ThreadLoad) -> Option<(&str, u32)> {
-        let (prefix, n) = t.name.rsplit_once('-')?;
-        Some((prefix, n.parse().ok()?))
-    }
-    let mut counts: Vec<(&str, usize)> = Vec::new();
-    for t in &report.threads {
-        if let Some((p, _)) = numbered(t) {
-            match counts.iter_mut().find(|c| c.0 == p) {
-                Some(c) => c.1 += 1,
-                None => counts.push((p, 1)),
-            }
-        }
-    }
-    let best = counts
+    let (mut members, singles): (Vec<&ThreadLoad>, Vec<&ThreadLoad>) = ordered(report)
         .into_iter()
-        .filter(|c| c.1 >= min_members)
-        .max_by_key(|c| c.1);
-    let Some((prefix, _)) = best else {
+        .partition(|t| t.role.lane().is_some());
+    if members.is_empty() || members.len() < min_members {
         return (ordered(report), None);
-    };
-    let mut members: Vec<(u32, &ThreadLoad)> = Vec::new();
-    let mut singles: Vec<&ThreadLoad> = Vec::new();
-    for t in ordered(report) {
-        match numbered(t) {
-            Some((p, n)) if p == prefix => members.push((n, t)),
-            _ => singles.push(t),
-        }
     }
-    members.sort_by_key(|m| m.0);
-    let members = members.into_iter().map(|m| m.1).collect();
-    (singles, Some((prefix.to_string(), members)))
+    members.sort_by_key(|t| t.role.lane());
+    (singles, Some((ThreadRole::POOL_GROUP.to_string(), members)))
 }
 
 /// The report's threads in the order the panel shows them (the sampler
