@@ -469,3 +469,52 @@ fn the_model_row_says_what_auto_runs() {
     let row = text.iter().find(|r| r.contains("model")).unwrap();
     assert!(row.contains("auto → exact (dense:"), "{text:#?}");
 }
+
+/// The random scene that broke its tolerance (94 265 spheres at speed 16.6,
+/// dt 1/15): `exact` was predicted under its event cap, ran into it, and
+/// finished the step in free flight. A scene predicted within
+/// `EXACT_CAP_MARGIN` of the cap (here 94 265 spheres at speed 12, so that
+/// a range of radii is), where the costs alone say `exact`, now runs `swept`
+/// when `swept` fits its own cap; without the margin this fails.
+#[test]
+fn a_scene_near_exacts_event_cap_runs_swept() {
+    use ballpit::physics::auto::{EXACT_CAP_MARGIN, costs, rates};
+    use ballpit::physics::exact::{EVENT_CAP_BASE, EVENT_CAP_PER_SPHERE};
+    let (n, dt) = (94_265_usize, 1.0 / 15.0);
+    let cap = (EVENT_CAP_BASE + EVENT_CAP_PER_SPHERE * n as u64) as f64;
+    let mut near_cap = 0;
+    for i in 0..1000 {
+        let r = 0.0005 + 0.00001 * f64::from(i);
+        let packing = n as f64 * 4.0 / 3.0 * std::f64::consts::PI * r.powi(3);
+        let s = Summary {
+            count: n,
+            size: 1.0,
+            r_min: r,
+            r_max: r,
+            r_mean: r,
+            packing,
+            v_rms: 12.0,
+            v_max: 36.0,
+        };
+        let rt = rates(&s);
+        let per_step = (rt.contacts + rt.walls + rt.crossings) * dt;
+        let c = costs(&s, dt, 1, 1, true);
+        // Near the cap, and where today's costs alone would say exact.
+        if per_step * EXACT_CAP_MARGIN > cap && per_step <= cap && c.exact < c.swept {
+            near_cap += 1;
+            let ask = Ask {
+                dt,
+                frame: 1,
+                tol: tol(0.1),
+                parts: 1,
+                floor: 0,
+                readouts: true,
+            };
+            let got = choose(&s, ask);
+            assert_eq!(got.model, ModelKind::Swept, "r {r}: {}", got.reason);
+            assert!(got.reason.contains("event cap"), "{}", got.reason);
+            assert!(!got.unmet);
+        }
+    }
+    assert!(near_cap > 0, "no radius put the scene near exact's cap");
+}

@@ -7,11 +7,16 @@ use super::latch::TERMINAL;
 use super::msg::Msg;
 use crossbeam_channel::Sender;
 use crossterm::{cursor, execute, queue, terminal};
+use parking_lot::{Condvar, Mutex};
 use std::io::{self, Write};
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
 
 static PANICKED: AtomicBool = AtomicBool::new(false);
+/// Set once the panic hook has restored the terminal and printed the
+/// message, so the process does not end before the message is out.
+static REPORTED: (Mutex<bool>, Condvar) = (Mutex::new(false), Condvar::new());
 static WAKE: OnceLock<Sender<Msg>> = OnceLock::new();
 static HOOK: OnceLock<()> = OnceLock::new();
 
@@ -28,6 +33,11 @@ impl Guard {
                 // Restore first, so the message lands on the normal screen.
                 restore();
                 previous(info);
+                {
+                    let (done, told) = &REPORTED;
+                    *done.lock() = true;
+                    told.notify_all();
+                }
                 if let Some(tx) = WAKE.get() {
                     let _ = tx.send(Msg::Panic);
                 }
@@ -66,6 +76,20 @@ fn put_back() {
     let _ = execute!(out, cursor::Show, terminal::LeaveAlternateScreen);
     let _ = out.flush();
     let _ = terminal::disable_raw_mode();
+}
+
+/// After a panic: wait (at most `limit`) until the hook has printed its
+/// message; the frame loop sees the panic as soon as it starts, and would
+/// otherwise end the process while the message is still being written.
+pub fn wait_for_panic_report(limit: Duration) {
+    let (done, told) = &REPORTED;
+    let end = Instant::now() + limit;
+    let mut done = done.lock();
+    while !*done {
+        if told.wait_until(&mut done, end).timed_out() {
+            return;
+        }
+    }
 }
 
 /// Whether a panic happened anywhere since start.

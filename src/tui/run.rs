@@ -97,6 +97,7 @@ pub fn run_with(
     // A panic restores the terminal, so the frame loop may stop on a refused
     // write first: the panic is the reason to report.
     if result.is_err() && guard::panicked() {
+        guard::wait_for_panic_report(Duration::from_secs(2));
         result = Err(anyhow!("a thread panicked (message above)"));
     }
     if let Some(sig) = signals::ending() {

@@ -5,7 +5,9 @@
 //! stricter models are let in until the scene changes).
 mod choose;
 
-pub use choose::{Ask, Choice, Costs, Rates, Summary, choose, costs, discrete_overlap, rates};
+pub use choose::{
+    Ask, Choice, Costs, EXACT_CAP_MARGIN, Rates, Summary, choose, costs, discrete_overlap, rates,
+};
 
 use super::exec::Exec;
 use super::model::{Model, ModelKind};
