@@ -42,12 +42,13 @@ struct Centre {
     radius: f64,
 }
 
-/// One entry of a neighbour list: the neighbour, and where this sphere sits
-/// in the neighbour's own list, so unlinking a pair is O(1) both ways.
+/// One entry of a neighbour list: the neighbour. Where this sphere sits in
+/// the neighbour's own list is found by a search of that list (about a
+/// dozen entries, one or two cache lines), not stored: at a million dense
+/// spheres the stored place was half the lists' memory (docs/perf-log.md).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Link {
     pub j: Label,
-    back: u32,
 }
 
 /// Where a sphere's list is kept: in the flat array (a bulk sphere) or,
@@ -142,23 +143,24 @@ impl Lists {
     /// Make `i` and `j` neighbours.
     #[inline]
     fn link(&mut self, i: Label, j: Label) {
-        let (li, lj) = (self.of(i).len() as u32, self.of(j).len() as u32);
-        self.push(i, Link { j, back: lj });
-        self.push(j, Link { j: i, back: li });
+        self.push(i, Link { j });
+        self.push(j, Link { j: i });
     }
 
     /// Remove `i` from all its neighbours' lists and empty its own.
     fn unlink_all(&mut self, i: Label) {
         for k in 0..self.of(i).len() {
-            let Link { j, back } = self.of(i)[k];
-            let last = self.of(j).len() - 1;
-            if back as usize != last {
-                // Move j's last entry into the hole and repoint its partner.
-                let moved = self.of(j)[last];
-                self.of_mut(j)[back as usize] = moved;
-                self.of_mut(moved.j)[moved.back as usize].back = back;
+            let j = self.of(i)[k].j;
+            let list = self.of_mut(j);
+            // A pair is linked once, so `i` is in `j`'s list exactly once.
+            let at = list.iter().position(|l| l.j == i);
+            debug_assert!(at.is_some(), "neighbours are linked both ways");
+            if let Some(at) = at {
+                // Move j's last entry into the hole.
+                let last = list.len() - 1;
+                list[at] = list[last];
+                self.pop(j);
             }
-            self.pop(j);
         }
         match self.home[i.index()] {
             Home::FLAT => self.len[i.index()] = 0,
@@ -167,7 +169,7 @@ impl Lists {
     }
 
     /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
-    /// every list keeps its order, so the `back` places hold.
+    /// every list keeps its order.
     #[cfg(feature = "experiments")]
     fn relabel(&mut self, perm: &[Label], inv: &[Label]) {
         apply_chunks(&mut self.flat, self.stride, perm);
@@ -364,5 +366,37 @@ impl NeighbourLists {
     fn cell_index(&self, p: DVec3) -> usize {
         let [x, y, z] = self.coords(p);
         x + self.per_side * (y + self.per_side * z)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Label, Link, Lists};
+
+    #[test]
+    fn a_link_is_the_neighbour_alone() {
+        // Most of the memory of `exact` at a million dense spheres.
+        assert_eq!(size_of::<Link>(), 4);
+    }
+
+    #[test]
+    fn unlinking_fills_each_hole_with_the_lists_last_entry() {
+        let mut l = Lists::default();
+        l.reset(5);
+        let at = Label::at;
+        for (i, j) in [(0, 1), (2, 1), (1, 3), (4, 1), (0, 3)] {
+            l.link(at(i), at(j));
+        }
+        let ids = |l: &Lists, i| l.of(at(i)).iter().map(|k| k.j.index()).collect::<Vec<_>>();
+        assert_eq!(ids(&l, 1), [0, 2, 3, 4]);
+        l.unlink_all(at(0));
+        // 0 left 1's list (4, its last, took the hole) and 3's.
+        assert_eq!(ids(&l, 0), Vec::<usize>::new());
+        assert_eq!(ids(&l, 1), [4, 2, 3]);
+        assert_eq!(ids(&l, 3), [1]);
+        l.unlink_all(at(1));
+        for i in 0..5 {
+            assert_eq!(ids(&l, i), Vec::<usize>::new(), "list of {i}");
+        }
     }
 }
