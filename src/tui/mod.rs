@@ -31,7 +31,8 @@ pub mod threads;
 pub mod wrap;
 pub mod writer;
 
-pub use run::{AfterFirstFrame, RunExtras, run, run_with};
+pub use present::AfterFirstFrame;
+pub use run::{RunExtras, run, run_with};
 pub use theme::ColorChoice;
 
 /// Largest frame rate the frame loop takes (`--fps`).

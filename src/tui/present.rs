@@ -9,7 +9,6 @@ use super::msg::Msg;
 use super::output::{Counting, Lean, Sink};
 use super::pacing::Pacer;
 use super::readouts::Stats;
-use super::run::AfterFirstFrame;
 use super::state::AppState;
 use super::theme::Palette;
 use super::writer::Output;
@@ -24,6 +23,10 @@ use ratatui::backend::Backend;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
+
+/// Called once on the frame loop's thread when the first frame has gone to
+/// the terminal.
+pub type AfterFirstFrame = Box<dyn FnOnce()>;
 
 type Term = Terminal<Lean<Counting<Sink>>>;
 

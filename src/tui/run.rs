@@ -1,7 +1,7 @@
 //! The frame loop and its pacing.
 use super::guard::{self, Guard};
 use super::msg::Msg;
-use super::present::{Presenter, Scene};
+use super::present::{AfterFirstFrame, Presenter, Scene};
 use super::readouts::Stats;
 use super::state::AppState;
 use super::theme::Palette;
@@ -17,10 +17,6 @@ use std::time::{Duration, Instant};
 
 /// Per-thread CPU is sampled once a second: a minute of history is 60 bars.
 const SAMPLE_PERIOD: Duration = Duration::from_secs(1);
-
-/// Called once on the frame loop's thread when the first frame has gone to
-/// the terminal.
-pub type AfterFirstFrame = Box<dyn FnOnce()>;
 
 /// What a caller may add to [`run`].
 #[derive(Default)]

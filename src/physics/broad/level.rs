@@ -2,6 +2,7 @@
 //! of their ball's centre (a counting sort by cell key), the same-level
 //! pairs, and the searches around a point or along the faces of the box.
 use super::super::exec::Exec;
+use super::entry::{Ball, Entry, Source};
 use super::place::{place_indirect, place_layered, running_sums};
 use glam::DVec3;
 use parking_lot::Mutex;
@@ -13,23 +14,6 @@ const KEY_BLOCK: usize = 2048;
 /// then copies the records (measured: 3–6 % faster at 100 000 spheres, no
 /// gain at 10 000, where everything stays in cache).
 const INDIRECT_MIN: usize = 1 << 15;
-
-/// A sphere's ball for the step: it stays within `reach` of `pos`.
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Ball {
-    pub(super) pos: DVec3,
-    pub(super) reach: f64,
-}
-
-/// A sphere in a level: its ball, id and padded cell key (on its way into
-/// the first level, [`WIDE`] when too wide for it). One record, so that
-/// sorting it into place writes one place in memory, not three.
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Entry {
-    pub(super) ball: Ball,
-    pub(super) id: u32,
-    pub(super) key: u32,
-}
 
 /// The key of a ball too wide for the level's cells: in no cell.
 pub(super) const WIDE: u32 = u32::MAX;
@@ -93,30 +77,6 @@ fn room(entries: &mut Vec<Entry>, n: usize) {
         ..Entry::default()
     });
 }
-/// Where the first level's records come from while it sorts them.
-pub(super) trait Source: Sync {
-    /// Each sphere's (cell key, reach), in id order.
-    fn keys(&self) -> impl DoubleEndedIterator<Item = (u32, f64)> + ExactSizeIterator;
-    /// Sphere `i`'s record.
-    fn entry(&self, i: usize) -> Entry;
-    /// The records themselves, when they lie in memory in id order.
-    fn records(&self) -> Option<&[Entry]>;
-}
-
-impl Source for [Entry] {
-    #[inline(always)]
-    fn keys(&self) -> impl DoubleEndedIterator<Item = (u32, f64)> + ExactSizeIterator {
-        self.iter().map(|e| (e.key, e.ball.reach))
-    }
-    #[inline(always)]
-    fn entry(&self, i: usize) -> Entry {
-        self[i]
-    }
-    fn records(&self) -> Option<&[Entry]> {
-        Some(self)
-    }
-}
-
 impl Level {
     /// Sizes the level for `n` spheres wanting cells of `want`. The cell
     /// table is zeroed here unless `lanes_zero` (the lanes of `fill_lanes`

@@ -6,13 +6,15 @@
 //! the finer levels by querying their cells over its own reach, so radii or
 //! speeds spread over orders of magnitude stay about linear in cost. Tiny
 //! scenes use all pairs.
+mod entry;
 mod level;
 mod place;
 
 use super::exec::{Exec, for_each_block_of, for_each_chunk};
 use super::sphere::Sphere;
+use entry::{Ball, Entry, Source};
 use glam::DVec3;
-use level::{Ball, Entry, Level, Source, WIDE, within};
+use level::{Level, WIDE, within};
 use parking_lot::Mutex;
 use std::cell::Cell;
 use std::sync::atomic::{AtomicUsize, Ordering};

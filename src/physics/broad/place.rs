@@ -2,7 +2,7 @@
 //! the cell table and the two ways one lane places its records into cells
 //! (by index, then copied; or layer by layer). Split from `level.rs`, which
 //! owns the level and calls them.
-use super::level::{Entry, Source};
+use super::entry::{Entry, Source};
 
 /// Inclusive running sums of `counts`, from `start` on; returns the last.
 /// The table has several cells per sphere, so this pass is long: each

@@ -6,7 +6,7 @@
 use super::cluster::{Chunk, Coarse, Member, Turn};
 use super::partition::{Partition, Slot};
 use super::path_ball;
-use super::rounds::RoundStats;
+use super::stats::RoundStats;
 use crate::physics::broad::Grid;
 use crate::physics::exec::{Exec, Serial};
 use crate::physics::sphere::Sphere;

@@ -27,6 +27,7 @@ mod knobs;
 mod partition;
 mod parts;
 mod rounds;
+mod stats;
 
 use super::broad::Pair;
 use super::contact::pair_toi;
@@ -40,8 +41,8 @@ use cluster::Coarse;
 use glam::DVec3;
 use parking_lot::Mutex;
 pub use parts::{ADDED_PAIRS, parts};
-pub use rounds::RoundStats;
 use rounds::Rounds;
+pub use stats::RoundStats;
 
 /// Reach balls are widened by this much so touching spheres, whose distance
 /// rounds either way, are always seen.

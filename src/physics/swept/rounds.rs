@@ -29,6 +29,7 @@
 use super::cluster::{Chunk, Coarse, Member, Run, Shared};
 use super::conflicts::{Conflicts, Finished};
 use super::partition::{Batch, Partition, Slot};
+use super::stats::RoundStats;
 use crate::physics::broad::Grid;
 use crate::physics::exec::{Exec, Serial, lanes_of, next_blocks};
 use crate::physics::sphere::Sphere;
@@ -56,35 +57,6 @@ struct BlockOut {
     chunk: Chunk,
     /// Finished runs' (member, member of another cluster) to compare.
     cross: Vec<(u32, u32)>,
-}
-
-/// How a step's events were cut, for benches and tests (for a step cut
-/// into parts, summed over them; `rounds` the most any part took).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct RoundStats {
-    /// Clusters of the first round.
-    pub clusters: usize,
-    pub rounds: usize,
-    /// Cluster runs after the first round.
-    pub reruns: usize,
-    /// Spheres with events.
-    pub involved: usize,
-    /// Pairs in different clusters whose paths were compared, and how many
-    /// of those were found apart (no rerun needed).
-    pub compared: usize,
-    pub apart: usize,
-}
-
-impl RoundStats {
-    /// Takes in the stats of another part of the same step.
-    pub fn add(&mut self, o: &RoundStats) {
-        self.clusters += o.clusters;
-        self.rounds = self.rounds.max(o.rounds);
-        self.reruns += o.reruns;
-        self.involved += o.involved;
-        self.compared += o.compared;
-        self.apart += o.apart;
-    }
 }
 
 /// The state kept from one round to the next of a step part, and scratch
