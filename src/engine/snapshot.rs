@@ -5,6 +5,7 @@ use crate::physics::auto::Choice;
 use crate::physics::broad::Grid;
 use crate::physics::discrete::pair_budget;
 use crate::physics::exec::{Busy, for_each_block_of, for_each_chunk};
+use crate::physics::sphere::overlap_rel;
 use crate::physics::world::escapes;
 use crate::physics::{Counters, Exec, World};
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
@@ -232,11 +233,8 @@ impl OverlapScratch {
             let (a, b) = (&sp[i as usize], &sp[j as usize]);
             let s = a.radius + b.radius;
             if a.pos.distance_squared(b.pos) < s * s {
-                let depth = s - a.pos.distance(b.pos);
-                if depth > 0.0 {
-                    let rel = depth / a.radius.min(b.radius);
-                    worst.fetch_max(rel.to_bits(), Ordering::Relaxed);
-                }
+                let rel = overlap_rel(a.pos, a.radius, b.pos, b.radius);
+                worst.fetch_max(rel.to_bits(), Ordering::Relaxed);
                 return true;
             }
             false

@@ -32,6 +32,15 @@ pub fn volume(radius: f64) -> f64 {
     4.0 / 3.0 * std::f64::consts::PI * radius * radius * radius
 }
 
+/// How deep two balls sink into each other, over the smaller radius; 0 when
+/// apart or touching. The one definition every readout and model uses, so
+/// their figures agree to the bit.
+#[inline]
+pub fn overlap_rel(pa: DVec3, ra: f64, pb: DVec3, rb: f64) -> f64 {
+    let depth = ra + rb - pa.distance(pb);
+    if depth > 0.0 { depth / ra.min(rb) } else { 0.0 }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

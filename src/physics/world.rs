@@ -1,4 +1,4 @@
-use super::sphere::Sphere;
+use super::sphere::{Sphere, overlap_rel};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Hands out generations: a number is never given twice in a process, so a
@@ -105,12 +105,8 @@ impl World {
     pub fn max_overlap_rel(&self) -> f64 {
         let mut worst: f64 = 0.0;
         super::broad::for_each_near_pair(&self.spheres, self.size, |i, j| {
-            let a = &self.spheres[i];
-            let b = &self.spheres[j];
-            let depth = a.radius + b.radius - a.pos.distance(b.pos);
-            if depth > 0.0 {
-                worst = worst.max(depth / a.radius.min(b.radius));
-            }
+            let (a, b) = (&self.spheres[i], &self.spheres[j]);
+            worst = worst.max(overlap_rel(a.pos, a.radius, b.pos, b.radius));
         });
         worst
     }

@@ -13,6 +13,7 @@ use super::ids::Label;
 use super::queue::EventQueue;
 use super::{Broad, EventDriven};
 use crate::physics::exec::{Exec, for_each_block};
+use crate::physics::sphere::overlap_rel;
 use parking_lot::Mutex;
 
 /// Spheres (lists) or cells (grid) per block of the search, spread over
@@ -74,7 +75,7 @@ impl<Q: EventQueue> EventDriven<Q> {
 }
 
 /// `worst`, or the overlap of bodies `i` and `j` relative to the smaller
-/// radius if deeper: the depth computed as `World::max_overlap_rel` does.
+/// radius if deeper (`overlap_rel`).
 #[inline]
 fn deeper(worst: f64, bodies: &Bodies, i: Label, j: Label) -> f64 {
     let (a, b) = (&bodies[i], &bodies[j]);
@@ -84,10 +85,5 @@ fn deeper(worst: f64, bodies: &Bodies, i: Label, j: Label) -> f64 {
     if a.pos.distance_squared(b.pos) >= s * s {
         return worst;
     }
-    let depth = s - a.pos.distance(b.pos);
-    if depth > 0.0 {
-        worst.max(depth / ra.min(rb))
-    } else {
-        worst
-    }
+    worst.max(overlap_rel(a.pos, ra, b.pos, rb))
 }

@@ -35,7 +35,7 @@ use super::detect::{Detection, SPHERE_BLOCK};
 use super::exec::{Exec, for_each_block_of, for_each_chunk};
 use super::flight::fly;
 use super::model::{Model, ModelKind};
-use super::sphere::Sphere;
+use super::sphere::{Sphere, overlap_rel};
 use super::world::World;
 use cluster::Coarse;
 use glam::DVec3;
@@ -339,12 +339,8 @@ impl Swept {
             for &(i, j) in &pairs[b * PAIR_BLOCK..end] {
                 let (a, c) = (&sp[i as usize], &sp[j as usize]);
                 let (dp, sigma) = (a.pos - c.pos, a.radius + c.radius);
-                // The same depth `World::max_overlap_rel` computes, to the bit.
                 if dp.length_squared() <= sigma * sigma * (1.0 + 1e-9) {
-                    let depth = sigma - a.pos.distance(c.pos);
-                    if depth > 0.0 {
-                        deepest = deepest.max(depth / a.radius.min(c.radius));
-                    }
+                    deepest = deepest.max(overlap_rel(a.pos, a.radius, c.pos, c.radius));
                 }
                 if pair_toi(dp, a.vel - c.vel, sigma).is_some_and(|t| t <= dt) {
                     meets.push((i, j));
