@@ -4,7 +4,7 @@
 //! the two run side by side; otherwise each is cut into blocks over the
 //! lanes (`pool`). Either way the results are the same bits.
 use super::broad::{Grid, Pair};
-use super::exec::{Exec, Serial, for_each_block_of};
+use super::exec::{Exec, PerBlock, Serial, for_each_block_of};
 use super::sphere::Sphere;
 use glam::DVec3;
 use parking_lot::Mutex;
@@ -20,7 +20,7 @@ pub(crate) struct Detection {
     /// Pairs the grid found and `keep` accepted, in a fixed order.
     pub pairs: Vec<Pair>,
     /// Per block of spheres, in order, the ones `wall` picked.
-    pub walls: Vec<Mutex<Vec<u32>>>,
+    pub walls: PerBlock<Vec<u32>>,
     /// Stop finding pairs once there are more than this (a step's work
     /// budget, see `swept`); `None` finds them all.
     pub pair_limit: Option<usize>,
@@ -45,9 +45,7 @@ impl Detection {
     {
         let n = spheres.len();
         let blocks = n.div_ceil(SPHERE_BLOCK);
-        while self.walls.len() < blocks {
-            self.walls.push(Mutex::new(Vec::new()));
-        }
+        self.walls.ensure(blocks);
         self.walls.truncate(blocks);
         let slots = &self.walls;
         let limit = self.pair_limit.unwrap_or(usize::MAX);
@@ -85,7 +83,7 @@ impl Detection {
     /// The spheres `wall` picked, in sphere order, into `out`.
     pub fn wall_hits(&self, out: &mut Vec<u32>) {
         out.clear();
-        for w in &self.walls {
+        for w in self.walls.iter() {
             out.extend_from_slice(&w.lock());
         }
     }

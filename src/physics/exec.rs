@@ -2,6 +2,8 @@
 //! thread: the engine hands it an `Exec`, and the physics cuts its work into
 //! fixed-size blocks whose results are combined in block order, so the answer
 //! is bit-identical whatever the executor and however many lanes it has.
+use parking_lot::Mutex;
+use std::ops::{Deref, DerefMut};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Runs work the physics hands it.
@@ -141,10 +143,7 @@ pub fn for_each_chunk<T: Send>(
     f: &(dyn Fn(usize, &mut [T]) + Sync),
 ) {
     let work = data.len();
-    let chunks: Vec<parking_lot::Mutex<&mut [T]>> = data
-        .chunks_mut(block)
-        .map(parking_lot::Mutex::new)
-        .collect();
+    let chunks: Vec<Mutex<&mut [T]>> = data.chunks_mut(block).map(Mutex::new).collect();
     for_each_block_of(exec, chunks.len(), work, &|b| f(b, &mut chunks[b].lock()));
 }
 
@@ -172,9 +171,60 @@ pub fn next_blocks(next: &AtomicUsize, blocks: usize) -> impl Iterator<Item = us
     })
 }
 
+/// One `T` per block (or lane) of a parallel section, each behind its own
+/// lock so a lane holds its block's alone. Kept from step to step and only
+/// grown, so the buffers inside keep their memory.
+pub struct PerBlock<T>(Vec<Mutex<T>>);
+
+impl<T> Default for PerBlock<T> {
+    fn default() -> Self {
+        PerBlock(Vec::new())
+    }
+}
+
+impl<T: Default> PerBlock<T> {
+    /// At least `n` blocks.
+    pub fn ensure(&mut self, n: usize) {
+        if self.0.len() < n {
+            self.0.resize_with(n, Default::default);
+        }
+    }
+}
+
+impl<T> PerBlock<T> {
+    pub fn truncate(&mut self, n: usize) {
+        self.0.truncate(n);
+    }
+}
+
+impl<T> Deref for PerBlock<T> {
+    type Target = [Mutex<T>];
+    fn deref(&self) -> &[Mutex<T>] {
+        &self.0
+    }
+}
+
+impl<T> DerefMut for PerBlock<T> {
+    fn deref_mut(&mut self) -> &mut [Mutex<T>] {
+        &mut self.0
+    }
+}
+
+/// `data` cut into consecutive spans of the lengths `lens` (which must sum
+/// to at most its length), each behind a lock for the lane that takes it.
+pub fn spans<T>(data: &mut [T], lens: impl Iterator<Item = usize>) -> Vec<Mutex<&mut [T]>> {
+    let mut rest = data;
+    lens.map(|len| {
+        let (head, tail) = std::mem::take(&mut rest).split_at_mut(len);
+        rest = tail;
+        Mutex::new(head)
+    })
+    .collect()
+}
+
 #[cfg(test)]
 mod tests {
-    use super::{Bound, MIN_WORK_PER_LANE, lanes_for};
+    use super::{Bound, MIN_WORK_PER_LANE, PerBlock, lanes_for, spans};
 
     #[test]
     fn lanes_follow_the_tightest_limit() {
@@ -194,5 +244,27 @@ mod tests {
         // Never none, whatever the limits.
         assert_eq!(lanes_for(0, 0, 0, 0, w).0, 1);
         assert_eq!(lanes_for(1, 2, 100, 100 * w, w), (1, Bound::Threads));
+    }
+
+    #[test]
+    fn spans_cut_in_order_and_leave_the_rest() {
+        let mut data: Vec<u32> = (0..10).collect();
+        let cut = spans(&mut data, [3, 0, 4].into_iter());
+        let got: Vec<Vec<u32>> = cut.iter().map(|s| s.lock().to_vec()).collect();
+        assert_eq!(got, vec![vec![0, 1, 2], vec![], vec![3, 4, 5, 6]]);
+    }
+
+    #[test]
+    fn per_block_grows_and_keeps_what_it_holds() {
+        let mut blocks: PerBlock<Vec<u32>> = PerBlock::default();
+        blocks.ensure(2);
+        blocks[1].lock().push(7);
+        blocks.ensure(1);
+        assert_eq!(blocks.len(), 2);
+        blocks.ensure(3);
+        assert_eq!(blocks.len(), 3);
+        assert_eq!(*blocks[1].lock(), vec![7]);
+        blocks.truncate(1);
+        assert_eq!(blocks.len(), 1);
     }
 }

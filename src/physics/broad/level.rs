@@ -1,7 +1,7 @@
 //! One uniform grid level of the broad phase: spheres binned by the cell
 //! of their ball's centre (a counting sort by cell key), the same-level
 //! pairs, and the searches around a point or along the faces of the box.
-use super::super::exec::Exec;
+use super::super::exec::{Exec, PerBlock, spans};
 use super::entry::{Ball, Entry, Source};
 use super::place::{place_indirect, place_layered, running_sums};
 use glam::DVec3;
@@ -42,10 +42,10 @@ pub(super) struct Level {
     /// The spheres of this level sorted by cell key, then a `NOWHERE` pad.
     pub(super) entries: Vec<Entry>,
     /// Per lane of `fill_lanes`: where each of its entries comes from.
-    orders: Vec<Mutex<Vec<u32>>>,
+    orders: PerBlock<Vec<u32>>,
     /// Per lane of `fill_lanes`, for a source without records: where each
     /// layer's records go next, and room for one layer's records.
-    layers: Vec<Mutex<(Vec<u32>, Vec<Entry>)>>,
+    layers: PerBlock<(Vec<u32>, Vec<Entry>)>,
     /// Largest reach in this level.
     pub(super) reach_max: f64,
 }
@@ -176,13 +176,10 @@ impl Level {
         };
         let lanes = super::super::exec::lanes_of(exec, cells, staged.keys().len()).min(64);
         let bounds: Vec<usize> = (0..=lanes).map(|l| l * cells / lanes).collect();
-        let mut tables: Vec<Mutex<&mut [u32]>> = Vec::with_capacity(lanes);
-        let mut rest = &mut self.cell_start[..cells];
-        for l in 0..lanes {
-            let (mine, more) = rest.split_at_mut(bounds[l + 1] - bounds[l]);
-            tables.push(Mutex::new(mine));
-            rest = more;
-        }
+        let tables = spans(
+            &mut self.cell_start[..cells],
+            bounds.windows(2).map(|w| w[1] - w[0]),
+        );
         let totals: Vec<Mutex<(u32, f64)>> = (0..lanes)
             .map(|_| Mutex::new(counted.unwrap_or((0, 0.0))))
             .collect();
@@ -191,7 +188,7 @@ impl Level {
         // which are counted here instead of the cells.
         let layered = staged.records().is_none();
         let layer = self.side * self.side;
-        self.layers.resize_with(lanes, Default::default);
+        self.layers.ensure(lanes);
         let layers = &self.layers;
         exec.for_lanes(lanes, &|l| {
             if counted.is_some() {
@@ -244,15 +241,10 @@ impl Level {
         // reading them where they lie (reads of misses overlap; writes of
         // them held the sort up).
         let records = staged.records().filter(|r| r.len() / lanes < INDIRECT_MIN);
-        self.orders.resize_with(lanes, Default::default);
+        self.orders.ensure(lanes);
         let orders = &self.orders;
-        let mut regions: Vec<Mutex<&mut [Entry]>> = Vec::with_capacity(lanes);
-        let mut rest = &mut self.entries[..sum as usize];
-        for l in 0..lanes {
-            let (mine, more) = rest.split_at_mut((offsets[l + 1] - offsets[l]) as usize);
-            regions.push(Mutex::new(mine));
-            rest = more;
-        }
+        let lens = offsets.windows(2).map(|w| (w[1] - w[0]) as usize);
+        let regions = spans(&mut self.entries[..sum as usize], lens);
         exec.for_lanes(lanes, &|l| {
             let (lo, hi) = (bounds[l] as u32, bounds[l + 1] as u32);
             let mut table = tables[l].lock();

@@ -10,12 +10,11 @@ mod entry;
 mod level;
 mod place;
 
-use super::exec::{Exec, for_each_block_of, for_each_chunk};
+use super::exec::{Exec, PerBlock, for_each_block_of, for_each_chunk};
 use super::sphere::Sphere;
 use entry::{Ball, Entry, Source};
 use glam::DVec3;
 use level::{Level, WIDE, within};
-use parking_lot::Mutex;
 use std::cell::Cell;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -49,7 +48,7 @@ pub struct Grid {
     /// From [`KEYED_MIN`] spheres on, in place of `staged`: the cell keys.
     keys: Vec<u32>,
     /// Per block of spheres, the widest ball among the keyed ones.
-    widest: Vec<Mutex<f64>>,
+    widest: PerBlock<f64>,
     /// The box's side, as of the last build.
     size: f64,
     /// Spheres not yet placed in a level: (ball, id).
@@ -57,8 +56,8 @@ pub struct Grid {
     scratch: Vec<f64>,
     /// Per block of spheres, the balls too wide for the first level (found
     /// in parallel, joined in block order).
-    wide: Vec<Mutex<Vec<(Ball, u32)>>>,
-    slots: Vec<Mutex<Vec<Pair>>>,
+    wide: PerBlock<Vec<(Ball, u32)>>,
+    slots: PerBlock<Vec<Pair>>,
 }
 
 /// The first level's records as cell keys and the spheres they come from.
@@ -191,7 +190,7 @@ impl Grid {
                 self.keys = Vec::new();
                 self.staged.resize(n, Entry::default());
                 let blocks = n.div_ceil(BUILD_BLOCK);
-                self.wide.resize_with(blocks, Default::default);
+                self.wide.ensure(blocks);
                 let level = &*level;
                 let wide = &self.wide;
                 for_each_chunk(exec, &mut self.staged, BUILD_BLOCK, &|b, chunk| {
@@ -267,8 +266,8 @@ impl Grid {
         let n = spheres.len();
         let blocks = n.div_ceil(BUILD_BLOCK);
         self.keys.resize(n, 0);
-        self.wide.resize_with(blocks, Default::default);
-        self.widest.resize_with(blocks, Default::default);
+        self.wide.ensure(blocks);
+        self.widest.ensure(blocks);
         let level = &self.levels[0];
         let (wide, widest) = (&self.wide, &self.widest);
         for_each_chunk(exec, &mut self.keys, BUILD_BLOCK, &|b, chunk| {
@@ -381,9 +380,7 @@ impl Grid {
     ) {
         out.clear();
         let units = self.units();
-        while self.slots.len() < units.len() {
-            self.slots.push(Mutex::new(Vec::new()));
-        }
+        self.slots.ensure(units.len());
         let this = &*self;
         for_each_block_of(exec, units.len(), this.entries(), &|u| {
             let mut v = this.slots[u].lock();
@@ -447,8 +444,8 @@ impl Grid {
         limit: usize,
     ) -> (bool, usize) {
         let units = self.units();
-        while STORE && self.slots.len() < units.len() {
-            self.slots.push(Mutex::new(Vec::new()));
+        if STORE {
+            self.slots.ensure(units.len());
         }
         let this = &*self;
         let found = AtomicUsize::new(0);

@@ -32,14 +32,13 @@ mod stats;
 use super::broad::Pair;
 use super::contact::pair_toi;
 use super::detect::{Detection, SPHERE_BLOCK};
-use super::exec::{Exec, for_each_block_of, for_each_chunk};
+use super::exec::{Exec, PerBlock, for_each_block_of, for_each_chunk};
 use super::flight::fly;
 use super::model::{Model, ModelKind};
 use super::sphere::{Sphere, overlap_rel};
 use super::world::World;
 use cluster::Coarse;
 use glam::DVec3;
-use parking_lot::Mutex;
 pub use parts::{ADDED_PAIRS, parts};
 use rounds::Rounds;
 pub use stats::RoundStats;
@@ -63,11 +62,11 @@ pub struct Swept {
     /// The spheres whose path reaches a wall this step.
     hits: Vec<u32>,
     /// Per block of candidate pairs: (meeting, near).
-    sorted: Vec<Mutex<(Vec<Pair>, Vec<Pair>)>>,
+    sorted: PerBlock<(Vec<Pair>, Vec<Pair>)>,
     meets: Vec<Pair>,
     near: Vec<Pair>,
     /// Per block of candidate pairs: the deepest overlap among them.
-    overlap: Vec<Mutex<f64>>,
+    overlap: PerBlock<f64>,
     rounds: Rounds,
     /// The last step's `rounds` stats, over all its parts.
     step_stats: RoundStats,
@@ -324,10 +323,8 @@ impl Swept {
     fn sort_pairs(&mut self, sp: &[Sphere], dt: f64, exec: &dyn Exec) -> f64 {
         let pairs = &self.detect.pairs;
         let blocks = pairs.len().div_ceil(PAIR_BLOCK);
-        while self.sorted.len() < blocks {
-            self.sorted.push(Mutex::new(Default::default()));
-            self.overlap.push(Mutex::new(0.0));
-        }
+        self.sorted.ensure(blocks);
+        self.overlap.ensure(blocks);
         let (sorted, overlap) = (&self.sorted, &self.overlap);
         for_each_block_of(exec, blocks, pairs.len(), &|b| {
             let mut guard = sorted[b].lock();

@@ -31,9 +31,8 @@ use super::conflicts::{Conflicts, Finished};
 use super::partition::{Batch, Partition, Slot};
 use super::stats::RoundStats;
 use crate::physics::broad::Grid;
-use crate::physics::exec::{Exec, Serial, lanes_of, next_blocks};
+use crate::physics::exec::{Exec, PerBlock, Serial, lanes_of, next_blocks};
 use crate::physics::sphere::Sphere;
-use parking_lot::Mutex;
 use std::sync::atomic::AtomicUsize;
 
 /// Fewer spheres with events than this run their clusters on one lane.
@@ -72,8 +71,8 @@ pub(super) struct Rounds {
     /// This round's clusters to run.
     batch: Batch,
     /// One run's scratch per lane, one output per block of clusters.
-    runs: Vec<Mutex<Run>>,
-    outs: Vec<Mutex<BlockOut>>,
+    runs: PerBlock<Run>,
+    outs: PerBlock<BlockOut>,
     /// The slots in sphere order, for [`Rounds::results`], and scratch for
     /// the late ones.
     in_order: Vec<Slot>,
@@ -249,12 +248,8 @@ impl Rounds {
     /// Scratch for `run_clusters` on `exec`.
     fn reserve(&mut self, exec: &dyn Exec) {
         let blocks = self.batch.todo.len().div_ceil(CLUSTER_BLOCK);
-        while self.runs.len() < exec.lanes() {
-            self.runs.push(Mutex::new(Run::default()));
-        }
-        while self.outs.len() < blocks {
-            self.outs.push(Mutex::new(BlockOut::default()));
-        }
+        self.runs.ensure(exec.lanes());
+        self.outs.ensure(blocks);
     }
 
     fn run_clusters(&self, exec: &dyn Exec, sh: &Shared, absorb: bool) {
