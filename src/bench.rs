@@ -262,23 +262,10 @@ fn physics_cpu(engine: &Engine, names: &[String], before: &[(i32, f64)]) -> f64 
 
 /// The 1-minute load average (Linux), `None` elsewhere.
 pub fn load_average() -> Option<f64> {
-    std::fs::read_to_string("/proc/loadavg")
-        .ok()?
-        .split_whitespace()
-        .next()?
-        .parse()
-        .ok()
+    crate::procfs::loadavg_1min()
 }
 
 /// `VmHWM` of this process (0 where /proc is not there).
 pub fn peak_rss_bytes() -> u64 {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .and_then(|l| l.split_whitespace().nth(1))
-                .and_then(|kb| kb.parse::<u64>().ok())
-        })
-        .map_or(0, |kb| kb * 1024)
+    crate::procfs::status_kib("VmHWM").map_or(0, |kib| kib.saturating_mul(1024))
 }

@@ -6,6 +6,7 @@ pub mod engine;
 pub mod error;
 pub mod memory;
 pub mod physics;
+pub(crate) mod procfs;
 pub mod progress;
 pub mod scaling;
 pub mod scene;

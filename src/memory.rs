@@ -52,13 +52,8 @@ pub fn need(count: usize, model: Option<ModelKind>) -> u64 {
 /// (`ulimit -v`) leaves beyond what the process already maps, if that is
 /// lower, in bytes (`None` when neither is known).
 pub fn available() -> Option<u64> {
-    let free = std::fs::read_to_string("/proc/meminfo")
-        .ok()
-        .and_then(|t| parse_meminfo(&t));
-    let mapped = std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|t| parse_kb(&t, "VmSize:"))
-        .unwrap_or(0);
+    let free = crate::procfs::meminfo_kib("MemAvailable").map(|kib| kib.saturating_mul(1024));
+    let mapped = crate::procfs::status_kib("VmSize").map_or(0, |kib| kib.saturating_mul(1024));
     let limit = rustix::process::getrlimit(rustix::process::Resource::As)
         .current
         .map(|l| l.saturating_sub(mapped));
@@ -66,18 +61,6 @@ pub fn available() -> Option<u64> {
         (Some(f), Some(l)) => Some(f.min(l)),
         (f, l) => f.or(l),
     }
-}
-
-/// The `MemAvailable:` line of a meminfo text, in bytes.
-pub fn parse_meminfo(text: &str) -> Option<u64> {
-    parse_kb(text, "MemAvailable:")
-}
-
-/// The `key  N kB` line of a /proc text, in bytes.
-fn parse_kb(text: &str, key: &str) -> Option<u64> {
-    let line = text.lines().find(|l| l.starts_with(key))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb.saturating_mul(1024))
 }
 
 /// Whether `count` spheres fit in `budget` bytes free; the message says how
@@ -143,14 +126,6 @@ fn mib(bytes: u64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn reads_mem_available() {
-        let text =
-            "MemTotal:       24576000 kB\nMemFree:         1000 kB\nMemAvailable:   23000000 kB\n";
-        assert_eq!(parse_meminfo(text), Some(23_000_000 * 1024));
-        assert_eq!(parse_meminfo("MemTotal: 5 kB\n"), None);
-    }
 
     #[test]
     fn refuses_what_exceeds_half_of_what_is_free() {

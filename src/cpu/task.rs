@@ -1,28 +1,25 @@
 //! Reading thread run times out of `/proc/self/task` (Linux only; other
 //! systems get empty answers).
 use super::ThreadRole;
-use std::fs;
+use crate::procfs;
 
 /// `(tid, name, cpu_seconds)` for every thread of the process, by tid. The
 /// main thread (tid = pid) carries the program's name in the kernel; it is
 /// listed as `main`, the name the article and the screen use for it.
 pub fn read_threads() -> Vec<(i32, String, f64)> {
     let pid = std::process::id() as i32;
-    let Ok(dir) = fs::read_dir("/proc/self/task") else {
-        return Vec::new();
-    };
-    let mut out: Vec<(i32, String, f64)> = dir
-        .filter_map(|e| {
-            let tid: i32 = e.ok()?.file_name().to_str()?.parse().ok()?;
+    let mut out: Vec<(i32, String, f64)> = procfs::task_ids()
+        .into_iter()
+        .filter_map(|tid| {
             // A thread may exit between listing and reading: skip it then.
             let secs = thread_cpu_seconds_of(tid)?;
-            let name = fs::read_to_string(format!("/proc/self/task/{tid}/comm")).ok()?;
+            let name = procfs::task_comm(tid)?;
             let name = if tid == pid {
-                &ThreadRole::Main.name()
+                ThreadRole::Main.name().into_owned()
             } else {
-                name.trim_end()
+                name
             };
-            Some((tid, name.to_string(), secs))
+            Some((tid, name, secs))
         })
         .collect();
     out.sort_by_key(|t| t.0);
@@ -31,22 +28,17 @@ pub fn read_threads() -> Vec<(i32, String, f64)> {
 
 /// CPU seconds (user + system) thread `tid` of this process has run.
 pub fn thread_cpu_seconds_of(tid: i32) -> Option<f64> {
-    // schedstat's first field: nanoseconds on a CPU, exact.
-    if let Ok(s) = fs::read_to_string(format!("/proc/self/task/{tid}/schedstat"))
-        && let Some(ns) = s
-            .split_whitespace()
-            .next()
-            .and_then(|f| f.parse::<u64>().ok())
-    {
+    // schedstat's first field: nanoseconds on a CPU, exact; else the ticks
+    // of `stat`.
+    if let Some(ns) = procfs::task_schedstat_ns(tid) {
         return Some(ns as f64 * 1e-9);
     }
-    let stat = fs::read_to_string(format!("/proc/self/task/{tid}/stat")).ok()?;
-    stat_cpu_seconds(&stat)
+    Some(tick_seconds(procfs::task_stat_ticks(tid)?))
 }
 
-/// utime + stime out of a `stat` line, in seconds.
-pub fn stat_cpu_seconds(stat: &str) -> Option<f64> {
-    Some(super::machine::stat_ticks(stat)? as f64 / ticks_per_second())
+/// Clock ticks of a `stat` time in seconds.
+fn tick_seconds(ticks: u64) -> f64 {
+    ticks as f64 / ticks_per_second()
 }
 
 /// The kernel's clock tick for `stat` times (`sysconf(_SC_CLK_TCK)`, from
@@ -72,12 +64,6 @@ pub fn current_tid() -> Option<i32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn stat_fields_after_odd_names() {
-        let line = "42 (a) b (c)) R 1 1 1 0 -1 4194304 132 0 0 0 250 130 0 0 20 0 1 0";
-        assert_eq!(stat_cpu_seconds(line), Some(380.0 / ticks_per_second()));
-    }
 
     #[test]
     fn the_clock_tick_is_the_kernels() {
