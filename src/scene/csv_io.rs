@@ -54,61 +54,18 @@ pub fn parse_with(
         .has_headers(true)
         .trim(csv::Trim::All)
         .from_reader(text.as_bytes());
-    let header = rdr
-        .headers()
-        .map_err(|e| bad_input!("{name} line 1: cannot read the header: {e}"))?
-        .clone();
-    if header.iter().collect::<Vec<_>>() != HEADER {
-        return bad!(
-            "{name} line 1: header must be `{}`, got `{}`",
-            HEADER.join(","),
-            header.iter().collect::<Vec<_>>().join(",")
-        );
-    }
+    check_header(&mut rdr, name)?;
     let mut spheres = Vec::new();
     // Where each record starts; its line is counted only for a message (a
     // count per record would make loading quadratic in the file's size).
     let mut starts = Vec::new();
-    // Lines counted from the bytes, not by the reader, so CRLF files count
-    // like LF ones (a record's position may be the `\n` ending the last).
-    let line_at = |byte: u64| {
-        let start = byte as usize;
-        let skip = text.as_bytes()[start.min(text.len())..]
-            .iter()
-            .take_while(|&&b| b == b'\r' || b == b'\n')
-            .count();
-        super::line_of(text, start + skip)
-    };
     for rec in rdr.records() {
         let rec = rec.map_err(|e| {
-            let line = e.position().map_or(0, |p| line_at(p.byte()));
+            let line = e.position().map_or(0, |p| line_at(text, p.byte()));
             bad_input!("{name} line {line}: {e}")
         })?;
         let start = rec.position().map_or(0, csv::Position::byte);
-        let line = || line_at(start);
-        if rec.len() != 8 {
-            return bad!(
-                "{name} line {}: expected 8 fields, found {}",
-                line(),
-                rec.len()
-            );
-        }
-        let mut v = [0.0; 8];
-        for (k, (slot, field)) in v.iter_mut().zip(rec.iter()).enumerate() {
-            *slot = field.parse().map_err(|_| {
-                bad_input!(
-                    "{name} line {}: {} = `{field}` is not a number",
-                    line(),
-                    HEADER[k]
-                )
-            })?;
-        }
-        spheres.push(Sphere {
-            pos: DVec3::new(v[0], v[1], v[2]),
-            vel: DVec3::new(v[3], v[4], v[5]),
-            radius: v[6],
-            mass: v[7],
-        });
+        spheres.push(sphere_of(&rec, name, || line_at(text, start))?);
         starts.push(start);
     }
     if spheres.is_empty() {
@@ -118,9 +75,67 @@ pub fn parse_with(
     }
     let world = World::new(size, spheres);
     check_with(&world, overlaps, name, &|i| {
-        format!("line {}", line_at(starts[i]))
+        format!("line {}", line_at(text, starts[i]))
     })?;
     Ok(world)
+}
+
+/// The first row is [`HEADER`], or the message says what it is instead.
+fn check_header(rdr: &mut csv::Reader<&[u8]>, name: &str) -> Result<(), BadInput> {
+    let header = rdr
+        .headers()
+        .map_err(|e| bad_input!("{name} line 1: cannot read the header: {e}"))?;
+    if header.iter().collect::<Vec<_>>() != HEADER {
+        return bad!(
+            "{name} line 1: header must be `{}`, got `{}`",
+            HEADER.join(","),
+            header.iter().collect::<Vec<_>>().join(",")
+        );
+    }
+    Ok(())
+}
+
+/// The line of `text` a record at `byte` is on. Lines are counted from the
+/// bytes, not by the reader, so CRLF files count like LF ones (a record's
+/// position may be the `\n` ending the last).
+fn line_at(text: &str, byte: u64) -> usize {
+    let start = byte as usize;
+    let skip = text.as_bytes()[start.min(text.len())..]
+        .iter()
+        .take_while(|&&b| b == b'\r' || b == b'\n')
+        .count();
+    super::line_of(text, start + skip)
+}
+
+/// The sphere of one row, or what is wrong with it at `line()`.
+fn sphere_of(
+    rec: &csv::StringRecord,
+    name: &str,
+    line: impl Fn() -> usize,
+) -> Result<Sphere, BadInput> {
+    if rec.len() != 8 {
+        return bad!(
+            "{name} line {}: expected 8 fields, found {}",
+            line(),
+            rec.len()
+        );
+    }
+    let mut v = [0.0; 8];
+    for (k, (slot, field)) in v.iter_mut().zip(rec.iter()).enumerate() {
+        *slot = field.parse().map_err(|_| {
+            bad_input!(
+                "{name} line {}: {} = `{field}` is not a number",
+                line(),
+                HEADER[k]
+            )
+        })?;
+    }
+    Ok(Sphere {
+        pos: DVec3::new(v[0], v[1], v[2]),
+        vel: DVec3::new(v[3], v[4], v[5]),
+        radius: v[6],
+        mass: v[7],
+    })
 }
 
 pub fn write(world: &World, out: &mut impl Write) -> csv::Result<()> {

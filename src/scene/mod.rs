@@ -92,9 +92,9 @@ pub fn build_world(spec: &SceneSpec) -> Result<World, BadInput> {
 }
 
 /// [`build_world`] for a run that starts with `model`: `discrete` takes a
-/// scene file with overlapping spheres (as its own `--dump` may hold).
-// The checks read in the order the messages promise.
-#[allow(clippy::too_many_lines)]
+/// scene file with overlapping spheres (as its own `--dump` may hold). The
+/// checks read in the order the messages promise: the box, the source
+/// (stdin, CSV, TOML, preset), then the preset's values.
 pub fn build_world_for(spec: &SceneSpec, model: Option<ModelKind>) -> Result<World, BadInput> {
     let overlaps = if model == Some(ModelKind::Discrete) {
         place::Overlaps::Allow
@@ -105,77 +105,146 @@ pub fn build_world_for(spec: &SceneSpec, model: Option<ModelKind>) -> Result<Wor
         length("--box", size)?;
     }
     let scene = spec.scene.as_deref().unwrap_or("gas");
-    // `-`: a CSV or TOML scene on standard input, read within the larger
-    // (CSV) bound; a TOML one must then keep to its own.
-    let stdin = if scene == "-" {
-        Some(bounded::read_text(Path::new("/dev/stdin"), &csv_io::BOUND)?)
+    let stdin = read_stdin(scene)?;
+    let scene = if stdin.is_some() { "stdin" } else { scene };
+    if has_extension(scene, "csv") || stdin.as_deref().is_some_and(looks_like_csv) {
+        return csv_world(spec, scene, stdin.as_deref(), overlaps);
+    }
+    let file = if has_extension(scene, "toml") || stdin.is_some() {
+        Some(read_toml(scene, stdin.as_deref())?)
     } else {
         None
     };
-    let scene = if stdin.is_some() { "stdin" } else { scene };
-    if has_extension(scene, "csv") || stdin.as_deref().is_some_and(looks_like_csv) {
-        if spec.count.is_some() || spec.radius.is_some() || spec.speed.is_some() {
-            return bad!("--count, --radius and --speed do not apply to a CSV scene ({scene})");
-        }
-        let size = spec.size.unwrap_or(1.0);
-        return match &stdin {
-            Some(text) => csv_io::parse_with(text, size, scene, overlaps),
-            None => csv_io::read(Path::new(scene), size, overlaps),
-        };
-    }
-    let (file, merged) = if has_extension(scene, "toml") || stdin.is_some() {
-        let f = match &stdin {
-            Some(text) if text.len() as u64 > toml_file::BOUND.max_bytes => {
-                return bad!(
-                    "stdin holds {} bytes of TOML; a TOML scene is at most {} bytes ({})",
-                    text.len(),
-                    toml_file::BOUND.max_bytes,
-                    toml_file::BOUND.why
-                );
-            }
-            Some(text) => toml_file::parse(text, scene)?,
-            None => toml_file::read(Path::new(scene))?,
-        };
-        let merged = SceneSpec {
-            scene: f.preset.clone(),
-            count: spec.count.or(f.count),
-            radius: spec.radius.or(f.radius),
-            speed: spec.speed.or(f.speed),
-            seed: spec.seed.or(f.seed),
-            size: spec.size.or(f.size),
-        };
-        (Some((scene.to_string(), f)), merged)
-    } else {
-        (None, spec.clone())
-    };
-    let file_name = file.as_ref().map(|(n, _)| n.as_str());
-    // The file's name when the file set the key.
-    let from = |set: bool| file_name.filter(|_| set);
-    let f = file.as_ref().map(|(_, f)| f);
-    let box_label = label(
-        "--box",
-        spec.size.is_some(),
-        from(f.is_some_and(|f| f.size.is_some())),
-    );
+    let merged = file
+        .as_ref()
+        .map_or_else(|| spec.clone(), |f| merge(spec, f));
+    let labels = Labels::new(spec, file.as_ref().map(|f| (scene, f)));
     let size = merged.size.unwrap_or(1.0);
-    length(&box_label, size)?;
-    if let Some((name, f)) = file.as_ref().filter(|(_, f)| !f.sphere.is_empty()) {
-        let spheres = f
-            .sphere
-            .iter()
-            .map(|e| {
-                let mut s =
-                    Sphere::new(DVec3::from_array(e.pos), DVec3::from_array(e.vel), e.radius);
-                if let Some(m) = e.mass {
-                    s.mass = m;
-                }
-                s
-            })
-            .collect();
-        let world = World::new(size, spheres);
-        place::check_with(&world, overlaps, name, &|i| format!("sphere {}", i + 1))?;
-        return Ok(world);
+    length(&labels.size, size)?;
+    if let Some(f) = file.as_ref().filter(|f| !f.sphere.is_empty()) {
+        return listed_world(f, size, scene, overlaps);
     }
+    preset_world(&merged, &labels, size, model)
+}
+
+/// `-`: a CSV or TOML scene on standard input, read within the larger
+/// (CSV) bound; a TOML one must then keep to its own.
+fn read_stdin(scene: &str) -> Result<Option<String>, BadInput> {
+    if scene == "-" {
+        Ok(Some(bounded::read_text(
+            Path::new("/dev/stdin"),
+            &csv_io::BOUND,
+        )?))
+    } else {
+        Ok(None)
+    }
+}
+
+/// A sphere CSV, from `stdin` when given, else from the file `scene`.
+fn csv_world(
+    spec: &SceneSpec,
+    scene: &str,
+    stdin: Option<&str>,
+    overlaps: place::Overlaps,
+) -> Result<World, BadInput> {
+    if spec.count.is_some() || spec.radius.is_some() || spec.speed.is_some() {
+        return bad!("--count, --radius and --speed do not apply to a CSV scene ({scene})");
+    }
+    let size = spec.size.unwrap_or(1.0);
+    match stdin {
+        Some(text) => csv_io::parse_with(text, size, scene, overlaps),
+        None => csv_io::read(Path::new(scene), size, overlaps),
+    }
+}
+
+/// A TOML scene, from `stdin` (within the TOML bound) when given, else
+/// from the file `scene`.
+fn read_toml(scene: &str, stdin: Option<&str>) -> Result<toml_file::SceneFile, BadInput> {
+    match stdin {
+        Some(text) if text.len() as u64 > toml_file::BOUND.max_bytes => {
+            bad!(
+                "stdin holds {} bytes of TOML; a TOML scene is at most {} bytes ({})",
+                text.len(),
+                toml_file::BOUND.max_bytes,
+                toml_file::BOUND.why
+            )
+        }
+        Some(text) => toml_file::parse(text, scene),
+        None => toml_file::read(Path::new(scene)),
+    }
+}
+
+/// The flags over the file's keys: a flag given wins.
+fn merge(spec: &SceneSpec, f: &toml_file::SceneFile) -> SceneSpec {
+    SceneSpec {
+        scene: f.preset.clone(),
+        count: spec.count.or(f.count),
+        radius: spec.radius.or(f.radius),
+        speed: spec.speed.or(f.speed),
+        seed: spec.seed.or(f.seed),
+        size: spec.size.or(f.size),
+    }
+}
+
+/// Who gave each value, for the messages (see [`label`]).
+struct Labels {
+    size: String,
+    count: String,
+    radius: String,
+    speed: String,
+}
+
+impl Labels {
+    /// `file`: the scene file's name and keys, when there is one.
+    fn new(spec: &SceneSpec, file: Option<(&str, &toml_file::SceneFile)>) -> Labels {
+        // The file's name when the file set the key.
+        let from = |set: fn(&toml_file::SceneFile) -> bool| {
+            file.filter(|(_, f)| set(f)).map(|(name, _)| name)
+        };
+        Labels {
+            size: label("--box", spec.size.is_some(), from(|f| f.size.is_some())),
+            count: label("--count", spec.count.is_some(), from(|f| f.count.is_some())),
+            radius: label(
+                "--radius",
+                spec.radius.is_some(),
+                from(|f| f.radius.is_some()),
+            ),
+            speed: label("--speed", spec.speed.is_some(), from(|f| f.speed.is_some())),
+        }
+    }
+}
+
+/// The spheres a TOML file lists, checked.
+fn listed_world(
+    f: &toml_file::SceneFile,
+    size: f64,
+    name: &str,
+    overlaps: place::Overlaps,
+) -> Result<World, BadInput> {
+    let spheres = f
+        .sphere
+        .iter()
+        .map(|e| {
+            let mut s = Sphere::new(DVec3::from_array(e.pos), DVec3::from_array(e.vel), e.radius);
+            if let Some(m) = e.mass {
+                s.mass = m;
+            }
+            s
+        })
+        .collect();
+    let world = World::new(size, spheres);
+    place::check_with(&world, overlaps, name, &|i| format!("sphere {}", i + 1))?;
+    Ok(world)
+}
+
+/// The world of the preset `merged` names, its values checked first and
+/// the spheres it makes after.
+fn preset_world(
+    merged: &SceneSpec,
+    labels: &Labels,
+    size: f64,
+    model: Option<ModelKind>,
+) -> Result<World, BadInput> {
     let name = merged.scene.as_deref().unwrap_or("gas");
     let Some(preset) = presets::find(name) else {
         return bad!(
@@ -183,36 +252,43 @@ pub fn build_world_for(spec: &SceneSpec, model: Option<ModelKind>) -> Result<Wor
             presets::names()
         );
     };
-    let count_label = label(
-        "--count",
-        spec.count.is_some(),
-        from(f.is_some_and(|f| f.count.is_some())),
-    );
-    let radius_label = label(
-        "--radius",
-        spec.radius.is_some(),
-        from(f.is_some_and(|f| f.radius.is_some())),
-    );
-    let speed_label = label(
-        "--speed",
-        spec.speed.is_some(),
-        from(f.is_some_and(|f| f.speed.is_some())),
-    );
     let count = merged.count.unwrap_or(preset.count);
     if count > MAX_COUNT {
         return bad!(
-            "{count_label} {count} is more than the {MAX_COUNT} spheres ballpit supports ({})",
+            "{} {count} is more than the {MAX_COUNT} spheres ballpit supports ({})",
+            labels.count,
             crate::memory::need_text(count, model)
         );
     }
-    let radius = match (merged.radius, preset.packing) {
+    let radius = preset_radius(merged.radius, preset, count, size, &labels.radius)?;
+    let speed = merged.speed.unwrap_or(preset.speed * size);
+    if !speed.is_finite() || speed < 0.0 {
+        return bad!("{} must be a finite number >= 0, got {speed}", labels.speed);
+    }
+    let mut rng = place::rng(merged.seed.unwrap_or(DEFAULT_SEED));
+    let world = place::generate(preset, count, radius, speed, size, &mut rng)?;
+    check_energies(&world, count, &labels.speed, speed, radius)?;
+    place::check(&world, "generated scene", &|i| format!("sphere {i}"))?;
+    Ok(world)
+}
+
+/// The radius given, or the one the preset's packing (or its own radius)
+/// makes for `count` spheres, checked against the box.
+fn preset_radius(
+    given: Option<f64>,
+    preset: &presets::Preset,
+    count: usize,
+    size: f64,
+    radius_label: &str,
+) -> Result<f64, BadInput> {
+    let radius = match (given, preset.packing) {
         (Some(r), _) => r,
         (None, Some(phi)) if count > 0 => {
             (phi * size.powi(3) / (count as f64 * volume(1.0))).cbrt()
         }
         (None, _) => preset.radius * size,
     };
-    length(&radius_label, radius)?;
+    length(radius_label, radius)?;
     if 2.0 * radius >= size {
         return bad!(
             "{radius_label} {radius} is too big for a box of {size} (it must be under {})",
@@ -225,12 +301,18 @@ pub fn build_world_for(spec: &SceneSpec, model: Option<ModelKind>) -> Result<Wor
             MIN_RADIUS_REL * size
         );
     }
-    let speed = merged.speed.unwrap_or(preset.speed * size);
-    if !speed.is_finite() || speed < 0.0 {
-        return bad!("{speed_label} must be a finite number >= 0, got {speed}");
-    }
-    let mut rng = place::rng(merged.seed.unwrap_or(DEFAULT_SEED));
-    let world = place::generate(preset, count, radius, speed, size, &mut rng)?;
+    Ok(radius)
+}
+
+/// The energies of a generated world of `count` spheres are finite, and
+/// not all 0 when the spheres move.
+fn check_energies(
+    world: &World,
+    count: usize,
+    speed_label: &str,
+    speed: f64,
+    radius: f64,
+) -> Result<(), BadInput> {
     if !(world.spheres.iter().all(place::speed_ok) && world.kinetic_energy().is_finite()) {
         return bad!(
             "{speed_label} {speed:e} is too large: the spheres' energies or relative speeds squared would not be finite numbers"
@@ -241,8 +323,7 @@ pub fn build_world_for(spec: &SceneSpec, model: Option<ModelKind>) -> Result<Wor
             "{speed_label} {speed:e} is too small for spheres of radius {radius:e}: their kinetic energies underflow to 0, so energy figures would mean nothing"
         );
     }
-    place::check(&world, "generated scene", &|i| format!("sphere {i}"))?;
-    Ok(world)
+    Ok(())
 }
 
 /// A box or radius: finite, positive, and within [`LENGTH_RANGE`].
