@@ -470,51 +470,137 @@ fn the_model_row_says_what_auto_runs() {
     assert!(row.contains("auto → exact (dense:"), "{text:#?}");
 }
 
+/// A uniform scene of `n` spheres of radius `r` at rms speed `v` in a unit box.
+fn uniform(n: usize, r: f64, v: f64) -> Summary {
+    Summary {
+        count: n,
+        size: 1.0,
+        r_min: r,
+        r_max: r,
+        r_mean: r,
+        r2_mean: r * r,
+        packing: n as f64 * 4.0 / 3.0 * std::f64::consts::PI * r.powi(3),
+        v_rms: v,
+        v_max: 3.0 * v,
+    }
+}
+
+fn ask_swept_one_part(dt: f64) -> Ask {
+    Ask {
+        dt,
+        frame: 1,
+        tol: tol(0.1),
+        parts: 1,
+        floor: 0,
+        readouts: true,
+    }
+}
+
 /// The random scene that broke its tolerance (94 265 spheres at speed 16.6,
 /// dt 1/15): `exact` was predicted under its event cap, ran into it, and
 /// finished the step in free flight. A scene predicted within
-/// `EXACT_CAP_MARGIN` of the cap (here 94 265 spheres at speed 12, so that
-/// a range of radii is), where the costs alone say `exact`, now runs `swept`
-/// when `swept` fits its own cap; without the margin this fails.
+/// `EXACT_CAP_MARGIN` of the cap, where the costs alone say `exact`, now
+/// runs `swept` when `swept` fits its own cap; without the margin this
+/// fails. Counts where `exact`'s state stays in cache (at 94 265 its
+/// events are priced dearer, and the costs alone say `swept`), at speeds
+/// that bring a range of radii near the cap.
 #[test]
 fn a_scene_near_exacts_event_cap_runs_swept() {
     use ballpit::physics::auto::{EXACT_CAP_MARGIN, costs, rates};
     use ballpit::physics::exact::{EVENT_CAP_BASE, EVENT_CAP_PER_SPHERE};
-    let (n, dt) = (94_265_usize, 1.0 / 15.0);
-    let cap = (EVENT_CAP_BASE + EVENT_CAP_PER_SPHERE * n as u64) as f64;
+    let dt = 1.0 / 15.0;
     let mut near_cap = 0;
-    for i in 0..1000 {
-        let r = 0.0005 + 0.00001 * f64::from(i);
-        let packing = n as f64 * 4.0 / 3.0 * std::f64::consts::PI * r.powi(3);
-        let s = Summary {
-            count: n,
-            size: 1.0,
-            r_min: r,
-            r_max: r,
-            r_mean: r,
-            packing,
-            v_rms: 12.0,
-            v_max: 36.0,
-        };
-        let rt = rates(&s);
-        let per_step = (rt.contacts + rt.walls + rt.crossings) * dt;
-        let c = costs(&s, dt, 1, 1, true);
-        // Near the cap, and where today's costs alone would say exact.
-        if per_step * EXACT_CAP_MARGIN > cap && per_step <= cap && c.exact < c.swept {
-            near_cap += 1;
-            let ask = Ask {
-                dt,
-                frame: 1,
-                tol: tol(0.1),
-                parts: 1,
-                floor: 0,
-                readouts: true,
-            };
-            let got = choose(&s, ask);
-            assert_eq!(got.model, ModelKind::Swept, "r {r}: {}", got.reason);
-            assert!(got.reason.contains("event cap"), "{}", got.reason);
-            assert!(!got.unmet);
+    for n in [10_000_usize, 20_000, 30_000] {
+        let cap = (EVENT_CAP_BASE + EVENT_CAP_PER_SPHERE * n as u64) as f64;
+        for v in [6.0, 12.0, 24.0, 48.0] {
+            for i in 0..1000 {
+                let r = 0.0005 + 0.00002 * f64::from(i);
+                let s = uniform(n, r, v);
+                // Parts of a path about a radius, as `swept` would cut.
+                let parts = (v * dt / r).ceil().clamp(1.0, 256.0) as u32;
+                let rt = rates(&s);
+                let per_step = (rt.contacts + rt.walls + rt.crossings) * dt;
+                let c = costs(&s, dt, parts, 1, true);
+                // Near the cap, and where the costs alone would say exact.
+                if per_step * EXACT_CAP_MARGIN > cap && per_step <= cap && c.exact < c.swept {
+                    near_cap += 1;
+                    let got = choose(
+                        &s,
+                        Ask {
+                            parts,
+                            ..ask_swept_one_part(dt)
+                        },
+                    );
+                    assert_eq!(got.model, ModelKind::Swept, "n {n} v {v}: {}", got.reason);
+                    assert!(got.reason.contains("event cap"), "{}", got.reason);
+                    assert!(!got.unmet);
+                }
+            }
         }
     }
-    assert!(near_cap > 0, "no radius put the scene near exact's cap");
+    assert!(near_cap > 0, "no scene put exact near its cap");
+}
+
+/// Above `exact`'s event cap `exact` would end its steps in free flight;
+/// where `swept` fits its own cap and budget it takes every contact, so
+/// it runs (the sweep's 94 265 spheres at speed 16.6, dt 1/15, broke T on
+/// `exact` and kept it on `swept`). Where `swept` does not fit either (the
+/// impossible scene above), `exact` and "cannot be met".
+#[test]
+fn a_scene_past_exacts_event_cap_runs_swept_where_swept_fits() {
+    use ballpit::physics::auto::rates;
+    use ballpit::physics::exact::{EVENT_CAP_BASE, EVENT_CAP_PER_SPHERE};
+    let (n, dt) = (94_265_usize, 1.0 / 15.0);
+    let cap = (EVENT_CAP_BASE + EVENT_CAP_PER_SPHERE * n as u64) as f64;
+    let s = uniform(n, 0.0056, 16.6);
+    let rt = rates(&s);
+    assert!((rt.contacts + rt.walls + rt.crossings) * dt > cap);
+    let got = choose(
+        &s,
+        Ask {
+            parts: 256,
+            ..ask_swept_one_part(dt)
+        },
+    );
+    assert_eq!(got.model, ModelKind::Swept, "{}", got.reason);
+    assert!(got.reason.contains("event cap"), "{}", got.reason);
+    assert!(!got.unmet);
+    // Once `swept` broke the tolerance, only `exact` is left.
+    let got = choose(
+        &s,
+        Ask {
+            parts: 256,
+            floor: 2,
+            ..ask_swept_one_part(dt)
+        },
+    );
+    assert_eq!(got.model, ModelKind::Exact);
+    assert!(got.unmet, "{}", got.reason);
+}
+
+/// Past about 30 000 spheres `exact`'s state leaves this host's cache and
+/// an event costs it more (`choose.rs`, `EXACT_CACHED`): the sweep's
+/// 49 807 spheres at speed 5.9, packing 0.11, `dt` 1/1920, where `auto`
+/// ran `exact` at 1.4× `swept`'s cost, now run `swept`; the same scene
+/// with a tenth of the spheres (its state in cache) still runs `exact`.
+#[test]
+fn exact_out_of_cache_is_priced_dearer() {
+    let dt = 1.0 / 1920.0;
+    let pick = |n: usize| {
+        let r = (0.112 / (n as f64 * 4.0 / 3.0 * std::f64::consts::PI)).cbrt();
+        let parts = (5.92 * dt / r).ceil().clamp(1.0, 256.0) as u32;
+        let ask = Ask {
+            dt,
+            frame: 1,
+            tol: tol(0.0),
+            parts,
+            floor: 0,
+            readouts: true,
+        };
+        choose(&uniform(n, r, 5.92), ask)
+    };
+    let big = pick(49_807);
+    assert_eq!(big.model, ModelKind::Swept, "{}", big.reason);
+    let small = pick(4_981);
+    assert_eq!(small.model, ModelKind::Exact, "{}", small.reason);
 }

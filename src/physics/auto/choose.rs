@@ -5,6 +5,7 @@
 use super::Tolerance;
 use crate::physics::exact::{EVENT_CAP_BASE, EVENT_CAP_PER_SPHERE};
 use crate::physics::model::ModelKind;
+use crate::physics::swept;
 use crate::physics::world::World;
 use std::f64::consts::PI;
 
@@ -19,6 +20,15 @@ const EXACT_CROSSING: f64 = 2.0e-7;
 const EXACT_SPHERE_STEP: f64 = 1.8e-9;
 const EXACT_SPHERE_SYNC: f64 = 1.1e-8;
 const EXACT_SPHERE_READOUT: f64 = 7.1e-8;
+/// `exact`'s events touch spheres, cells and queue entries at random, so
+/// once its state outgrows the cache an event costs more: by
+/// `1 + EXACT_MISS × (1 − EXACT_CACHED / N)` from `EXACT_CACHED` spheres
+/// up (its state is ~300–500 B a sphere against this host's 32 MB L3;
+/// fitted to steps of gas-like scenes of 1 000 to 100 000 spheres, which
+/// measured 0.7–1.2× the cached price up to 32 000 and 3–5× from 41 000,
+/// docs/models.md, "auto"). Its per-sphere passes stream, and stay.
+const EXACT_CACHED: f64 = 30_000.0;
+const EXACT_MISS: f64 = 5.5;
 /// `swept`: one sphere in one part of a step, and one contact or wall hit
 /// (its overlap readout is the next step's detection, reused).
 const SWEPT_SPHERE_STEP: f64 = 3.5e-8;
@@ -37,9 +47,6 @@ const DISCRETE_MARGIN: f64 = 2.0;
 /// capped step ends in free flight, breaking the tolerance (a random scene
 /// of 94 265 spheres at speed 16.6, dt 1/15, did at 0.9 of the cap).
 pub const EXACT_CAP_MARGIN: f64 = 2.0;
-/// `swept`'s event cap per step (`swept/` docs: 10 000 + 64 a sphere).
-const SWEPT_CAP_BASE: f64 = 10_000.0;
-const SWEPT_CAP_PER_SPHERE: f64 = 64.0;
 
 /// What the choice reads from the scene: one pass over the spheres.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -49,6 +56,9 @@ pub struct Summary {
     pub r_min: f64,
     pub r_max: f64,
     pub r_mean: f64,
+    /// The mean of r²: with `r_mean`, a pair's mean contact cross-section
+    /// when radii spread.
+    pub r2_mean: f64,
     pub packing: f64,
     pub v_rms: f64,
     pub v_max: f64,
@@ -57,12 +67,13 @@ pub struct Summary {
 impl Summary {
     pub fn of(world: &World) -> Summary {
         let n = world.spheres.len();
-        let (mut r_min, mut r_max, mut r_sum, mut vol, mut vv, mut v_max) =
-            (f64::INFINITY, 0.0_f64, 0.0, 0.0, 0.0, 0.0_f64);
+        let (mut r_min, mut r_max, mut r_sum, mut r2_sum, mut vol, mut vv, mut v_max) =
+            (f64::INFINITY, 0.0_f64, 0.0, 0.0, 0.0, 0.0, 0.0_f64);
         for s in &world.spheres {
             r_min = r_min.min(s.radius);
             r_max = r_max.max(s.radius);
             r_sum += s.radius;
+            r2_sum += s.radius * s.radius;
             vol += s.radius.powi(3);
             let v2 = s.vel.length_squared();
             vv += v2;
@@ -75,6 +86,7 @@ impl Summary {
             r_min: if n == 0 { 0.0 } else { r_min },
             r_max,
             r_mean: r_sum / nf,
+            r2_mean: r2_sum / nf,
             packing: 4.0 / 3.0 * PI * vol / world.size.powi(3),
             v_rms: (vv / nf).sqrt(),
             v_max: v_max.sqrt(),
@@ -118,9 +130,11 @@ pub fn rates(s: &Summary) -> Rates {
     let phi = s.packing.min(0.6);
     let g = (1.0 - 0.5 * phi) / (1.0 - phi).powi(3);
     let density = n / s.size.powi(3);
-    let sigma = 2.0 * s.r_mean;
+    // σ² the mean of (r_i + r_j)² over pairs, 2 (<r²> + <r>²): (2 <r>)²
+    // undercounts contacts by 1.5× when radii spread 50× (log-uniform).
+    let sigma2 = 2.0 * (s.r2_mean + s.r_mean * s.r_mean);
     // Enskog: z = 4 n σ² √(π kT/m) g, with kT/m = v_rms² / 3.
-    let per_sphere = 4.0 * density * sigma * sigma * (PI / 3.0).sqrt() * s.v_rms * g;
+    let per_sphere = 4.0 * density * sigma2 * (PI / 3.0).sqrt() * s.v_rms * g;
     // Mean |v_x| of a Maxwell gas: v_rms √(2 / 3π); three axes.
     let axis = 3.0 * s.v_rms * (2.0 / (3.0 * PI)).sqrt();
     let per_side = (s.size / (2.0 * s.r_max.max(1e-300)))
@@ -149,6 +163,12 @@ pub fn rates(s: &Summary) -> Rates {
     }
 }
 
+/// How much dearer an `exact` event is for a scene of `n` spheres than
+/// for one whose state stays in cache (see [`EXACT_CACHED`]).
+pub fn exact_memory(n: usize) -> f64 {
+    1.0 + EXACT_MISS * (1.0 - EXACT_CACHED / (n.max(1) as f64)).max(0.0)
+}
+
 /// Predicted seconds of physics per simulated second, per model.
 #[derive(Clone, Copy, Debug)]
 pub struct Costs {
@@ -168,7 +188,9 @@ pub fn costs(s: &Summary, dt: f64, swept_parts: u32, frame: u64, readouts: bool)
         discrete: DISCRETE_SPHERE_STEP * steps,
         swept: SWEPT_SPHERE_STEP * steps * f64::from(swept_parts.max(1))
             + SWEPT_EVENT * (r.contacts + r.walls),
-        exact: (EXACT_EVENT * (r.contacts + r.walls) + EXACT_CROSSING * r.crossings) * r.crowding
+        exact: (EXACT_EVENT * (r.contacts + r.walls) + EXACT_CROSSING * r.crossings)
+            * r.crowding
+            * exact_memory(s.count)
             + EXACT_SPHERE_STEP * steps
             + per_frame * frames,
     }
@@ -182,6 +204,18 @@ pub fn discrete_overlap(s: &Summary, dt: f64) -> f64 {
     } else {
         f64::INFINITY
     }
+}
+
+/// `swept`'s pair checks in a step of `parts` parts: each sphere against
+/// those its path ball of a part meets (reach two mean radii and the rms
+/// path of a part), at most all the others. Its parts keep this small but
+/// where they run out ([`crate::physics::swept::parts`] stops at 256).
+fn swept_work(s: &Summary, dt: f64, parts: u32) -> f64 {
+    let n = s.count as f64;
+    let k = f64::from(parts.max(1));
+    let reach = 2.0 * s.r_mean + s.v_rms * dt / k;
+    let met = (n / s.size.powi(3) * 4.0 / 3.0 * PI * reach.powi(3)).min((n - 1.0).max(0.0));
+    k * n * met
 }
 
 fn ratio(a: f64, b: f64) -> String {
@@ -223,15 +257,29 @@ pub fn choose(s: &Summary, ask: Ask) -> Choice {
     let r = rates(s);
     let per_step = (r.contacts + r.walls + r.crossings) * dt;
     let exact_cap = (EVENT_CAP_BASE + EVENT_CAP_PER_SPHERE * s.count as u64) as f64;
-    let swept_cap = SWEPT_CAP_BASE + SWEPT_CAP_PER_SPHERE * s.count as f64;
+    // `swept`'s caps, of a cluster and of a step, taken for a part's contacts.
+    let swept_cap = (swept::EVENT_CAP_BASE + swept::EVENT_CAP_PER_SPHERE * s.count) as f64;
+    let swept_budget = (swept::BUDGET_BASE + swept::BUDGET_PER_SPHERE * s.count as u64) as f64;
     let tol_text = format!("tol {tol}");
-    let swept_fits = r.contacts.max(0.0) * dt / f64::from(swept_parts.max(1)) < swept_cap;
+    let swept_fits = r.contacts.max(0.0) * dt / f64::from(swept_parts.max(1)) < swept_cap
+        && swept_work(s, dt, swept_parts) < swept_budget;
     let near_cap = per_step * EXACT_CAP_MARGIN > exact_cap && per_step <= exact_cap;
     if near_cap && floor <= 1 && swept_fits {
         return Choice {
             model: ModelKind::Swept,
             reason: format!(
                 "exact may hit its event cap (~{per_step:.0} events a step, cap {exact_cap:.0}); {tol_text}"
+            ),
+            unmet: false,
+        };
+    }
+    if per_step > exact_cap && floor <= 1 && swept_fits {
+        // `exact` would end its steps at the cap, in free flight; `swept`
+        // takes every contact within its own cap and budget.
+        return Choice {
+            model: ModelKind::Swept,
+            reason: format!(
+                "exact would pass its event cap (~{per_step:.0} events a step > {exact_cap:.0}); {tol_text}"
             ),
             unmet: false,
         };

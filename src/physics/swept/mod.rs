@@ -53,8 +53,11 @@ const PAIR_BLOCK: usize = 4096;
 /// spheres a rescan looks at, weights per event: `cluster.rs`): a base plus
 /// so much per sphere, so the worst step of 1 000 spheres (120 M) costs
 /// under a second of CPU here (docs/benchmarks.md).
-const BUDGET_BASE: u64 = 20_000_000;
-const BUDGET_PER_SPHERE: u64 = 100_000;
+pub const BUDGET_BASE: u64 = 20_000_000;
+pub const BUDGET_PER_SPHERE: u64 = 100_000;
+/// A cluster's event cap: a base plus so much per member (`cluster.rs`).
+pub const EVENT_CAP_BASE: usize = 10_000;
+pub const EVENT_CAP_PER_SPHERE: usize = 64;
 
 #[derive(Default)]
 pub struct Swept {
