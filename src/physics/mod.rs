@@ -11,6 +11,7 @@ pub mod exact;
 pub mod exec;
 pub mod flight;
 pub mod free_space;
+pub mod kind;
 pub mod model;
 pub mod reference;
 pub mod relax;

@@ -2,9 +2,8 @@
 //! tolerance, so every machine and every threading mode chooses alike. The
 //! costs are predicted from event and step counts, calibrated once against
 //! `ballpit tradeoff` (docs/models.md, "auto"), never timed.
-use super::Tolerance;
 use crate::physics::exact::{EVENT_CAP_BASE, EVENT_CAP_PER_SPHERE};
-use crate::physics::model::ModelKind;
+use crate::physics::kind::{Choice, ModelKind, Tolerance};
 use crate::physics::swept;
 use crate::physics::world::World;
 use std::f64::consts::PI;
@@ -92,15 +91,6 @@ impl Summary {
             v_max: v_max.sqrt(),
         }
     }
-}
-
-/// The model chosen and why, in the screen's words.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Choice {
-    pub model: ModelKind,
-    pub reason: String,
-    /// The tolerance cannot be kept by any model within its budget.
-    pub unmet: bool,
 }
 
 /// Predicted events per simulated second: contacts (Enskog's rate with

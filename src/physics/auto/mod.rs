@@ -5,69 +5,15 @@
 //! stricter models are let in until the scene changes).
 mod choose;
 
+pub use super::kind::{Choice, Tolerance};
 pub use choose::{
-    Ask, Choice, Costs, EXACT_CAP_MARGIN, Rates, Summary, choose, costs, discrete_overlap, rates,
+    Ask, Costs, EXACT_CAP_MARGIN, Rates, Summary, choose, costs, discrete_overlap, rates,
 };
 
 use super::exec::Exec;
-use super::model::{Model, ModelKind};
+use super::kind::ModelKind;
+use super::model::Model;
 use super::world::World;
-use std::fmt;
-
-/// The fraction of the smaller radius by which spheres may sink into each
-/// other, held in millionths so that a model kind stays `Eq` and `Hash`
-/// (a request finer than 1e-6 rounds to the stricter 0).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct Tolerance(u32);
-
-impl Tolerance {
-    pub const EXACT: Tolerance = Tolerance(0);
-    const PER_UNIT: f64 = 1e6;
-    /// The `<` / `>` keys' steps, about ×3 apart from a thousandth up.
-    pub const LADDER: [Tolerance; 7] = [
-        Tolerance(0),
-        Tolerance(1_000),
-        Tolerance(10_000),
-        Tolerance(30_000),
-        Tolerance(100_000),
-        Tolerance(300_000),
-        Tolerance(1_000_000),
-    ];
-
-    /// `t` in [0, 1]; anything else (negative, NaN, above 1) is refused.
-    pub fn new(t: f64) -> Option<Tolerance> {
-        (0.0..=1.0)
-            .contains(&t)
-            // In [0, 1e6] after the check, so the cast is exact.
-            .then(|| Tolerance((t * Self::PER_UNIT).floor() as u32))
-    }
-
-    pub fn fraction(self) -> f64 {
-        f64::from(self.0) / Self::PER_UNIT
-    }
-
-    /// The next step of the ladder up (looser) or down (tighter); a value
-    /// between steps (from `--tolerance`) goes to the neighbouring one, and
-    /// the ends stay where they are.
-    #[must_use]
-    pub fn step(self, looser: bool) -> Tolerance {
-        let l = &Self::LADDER;
-        if looser {
-            l.iter()
-                .copied()
-                .find(|&x| x > self)
-                .unwrap_or(l[l.len() - 1])
-        } else {
-            l.iter().rev().copied().find(|&x| x < self).unwrap_or(l[0])
-        }
-    }
-}
-
-impl fmt::Display for Tolerance {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.fraction())
-    }
-}
 
 /// How strict the models let in are: 0 all, 1 `swept` and `exact`, 2 `exact`.
 fn level(m: ModelKind) -> u8 {
