@@ -604,3 +604,49 @@ fn exact_out_of_cache_is_priced_dearer() {
     let small = pick(4_981);
     assert_eq!(small.model, ModelKind::Exact, "{}", small.reason);
 }
+
+/// Collisions pass the energy of big spheres started at the common speed
+/// to the small ones, so the scene `auto` chose for is gone within a few
+/// steps: the drift check looks again and chooses for the scene as it is,
+/// and says so. Equal spheres keep their rms speed (the energy is kept)
+/// and are never chosen for again.
+#[test]
+fn auto_chooses_again_when_collisions_change_the_speeds() {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(22);
+    let world = random_scene(&mut rng, 948, 0.043, 50.0, 14.0);
+    let dt = 1.0 / 15.0;
+    let mut model = ModelKind::Auto(tol(0.01)).build();
+    let mut w = world.clone();
+    let e0 = w.kinetic_energy();
+    let mut reasons = Vec::new();
+    for _ in 0..4 {
+        model.advance(&mut w, dt, 1, &Serial);
+        let read = model.max_overlap_rel(&w, dt, &Serial);
+        model.overlap_read(read.unwrap_or_else(|| w.max_overlap_rel()));
+        reasons.push(model.choice().unwrap().reason.clone());
+    }
+    assert!(!reasons[0].contains("drifted"), "{reasons:#?}");
+    assert!(
+        reasons[1..]
+            .iter()
+            .any(|r| r.contains("speeds drifted (rms 14")),
+        "{reasons:#?}"
+    );
+    assert!((w.kinetic_energy() - e0).abs() / e0 < 1e-9);
+    assert!(w.max_overlap_rel() <= 0.01 + 1e-12);
+    assert_eq!(w.escaped(), 0);
+
+    let spec = SceneSpec {
+        scene: Some("gas".into()),
+        ..SceneSpec::default()
+    };
+    let mut w = build_world(&spec).unwrap();
+    let mut model = ModelKind::Auto(tol(0.0)).build();
+    for _ in 0..200 {
+        model.advance(&mut w, 1.0 / 60.0, 1, &Serial);
+        let read = model.max_overlap_rel(&w, 1.0 / 60.0, &Serial);
+        model.overlap_read(read.unwrap_or_else(|| w.max_overlap_rel()));
+        let reason = &model.choice().unwrap().reason;
+        assert!(!reason.contains("drifted"), "{reason}");
+    }
+}
