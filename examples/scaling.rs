@@ -511,7 +511,7 @@ fn main() {
         for (world, model, steps, spent) in &mut runs {
             if sorted {
                 sort_in_space(world, cell);
-                model.invalidate();
+                world.touch();
             }
             model.advance(world, DT, 1, &Serial);
             let start = Instant::now();

@@ -140,8 +140,8 @@ fn changes_from_outside_rebuild_the_schedule() {
     m.advance(&mut w, 1.0 / 60.0, 10, &Serial);
     assert!(w.counters.sphere_collisions > 0);
     check_invariants(&w, e0, 1e-12, ov0.max(1e-10));
-    // And explicit invalidation is honoured too.
-    m.invalidate();
+    // And a touch (an edit from outside) reloads.
+    w.touch();
     m.advance(&mut w, 1.0 / 60.0, 5, &Serial);
     check_invariants(&w, e0, 1e-12, ov0.max(1e-10));
 }

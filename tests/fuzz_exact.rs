@@ -142,7 +142,7 @@ proptest! {
         let mut a = w.clone();
         let mut m = Exact::default();
         m.advance(&mut a, dt, 3, &Serial);
-        m.invalidate();
+        a.touch();
         m.advance(&mut a, dt, 3, &Serial);
         prop_assert!(!a.has_non_finite());
         prop_assert_eq!(a.escaped(), 0);

@@ -502,7 +502,6 @@ impl Engine {
     #[allow(clippy::unused_self)] // one of the engine's steps, called as one
     fn edited(&self, frame: &mut Frame) {
         frame.world.touch();
-        frame.model.invalidate();
         frame.energy_reset = frame.world.kinetic_energy();
     }
 

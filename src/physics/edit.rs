@@ -1,7 +1,7 @@
 //! Changing the spheres between frames (the count and radius keys) without
 //! breaking what the models promise: new spheres go only into free space,
 //! growing radii push the spheres apart, never into each other or a wall.
-//! The caller must `invalidate` the model afterwards.
+//! The caller must `World::touch` the world afterwards.
 use super::free_space::FreeSpace;
 use super::relax;
 use super::sphere::Sphere;

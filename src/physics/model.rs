@@ -3,14 +3,13 @@ pub use super::kind::{Choice, ModelKind};
 use super::world::World;
 
 /// A collision model. It may keep state between calls (schedules, grids); it
-/// must drop what depends on the spheres when `invalidate` is called.
+/// must drop what depends on the spheres when the world's generation moved
+/// (`World::touch`, the one signal of an edit from outside).
 pub trait Model: Send {
     fn kind(&self) -> ModelKind;
     /// Advance `world` by `steps` steps of `dt`. On return every sphere's
     /// position and velocity in `world` are those at `world.time`.
     fn advance(&mut self, world: &mut World, dt: f64, steps: u64, exec: &dyn Exec);
-    /// The spheres were changed from outside (added, removed, resized).
-    fn invalidate(&mut self) {}
     /// Into how many parts the model cut its last step (1: whole).
     fn last_parts(&self) -> u32 {
         1

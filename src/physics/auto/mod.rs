@@ -220,11 +220,6 @@ impl Model for Auto {
         }
     }
 
-    fn invalidate(&mut self) {
-        self.inner.invalidate();
-        self.key = None;
-    }
-
     fn last_parts(&self) -> u32 {
         self.inner.last_parts()
     }

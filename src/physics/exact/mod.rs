@@ -196,9 +196,11 @@ impl<Q: EventQueue> EventDriven<Q> {
         cell_grid::CELLS_PER_SPHERE
     }
 
-    /// Whether our bodies are exactly what we last wrote into `world`.
+    /// Whether our bodies are exactly what we last wrote into `world`, and
+    /// it was not touched since (an edit from outside reloads).
     fn matches(&self, world: &World) -> bool {
         self.valid
+            && world.generation() == self.synced_generation
             && world.size == self.size
             && world.time == self.synced_time
             && world.spheres.len() == self.bodies.len()
@@ -515,10 +517,6 @@ impl<Q: EventQueue + Send> Model for EventDriven<Q> {
             world.time = end;
         }
         self.write_back(world);
-    }
-
-    fn invalidate(&mut self) {
-        self.valid = false;
     }
 
     /// From the broad phase the next step uses anyway (see [`overlap`]); a

@@ -164,10 +164,6 @@ impl Model for Swept {
         }
     }
 
-    fn invalidate(&mut self) {
-        self.ahead = None;
-    }
-
     /// See `parts.rs`.
     fn last_parts(&self) -> u32 {
         self.last_parts
