@@ -155,7 +155,7 @@ pub fn rates(s: &Summary) -> Rates {
 
 /// How much dearer an `exact` event is for a scene of `n` spheres than
 /// for one whose state stays in cache (see [`EXACT_CACHED`]).
-pub fn exact_memory(n: usize) -> f64 {
+fn exact_memory(n: usize) -> f64 {
     1.0 + EXACT_MISS * (1.0 - EXACT_CACHED / (n.max(1) as f64)).max(0.0)
 }
 
