@@ -119,13 +119,6 @@ pub fn warnings(report: &BenchReport) -> Vec<String> {
 /// and the final world is moved out of it, so the spheres are held once.
 pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(BenchReport, World)> {
     let e0 = world.kinetic_energy();
-    let rel = |e: f64| {
-        if e0 > 0.0 {
-            (e - e0).abs() / e0
-        } else {
-            (e - e0).abs()
-        }
-    };
     let t_start = world.time;
     let frame = u64::from(settings.tick.max(1));
     let mut engine = Engine::headless(
@@ -138,86 +131,121 @@ pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(Ben
     let load_start = load_average();
     // CPU already run by the threads that exist before stepping; threads
     // born while stepping (pools) start from 0.
-    let mut cpu_before: Vec<(i32, f64)> = Vec::new();
-    for tid in [crate::cpu::current_tid(), engine.physics_tid()]
+    let cpu_before: Vec<(i32, f64)> = [crate::cpu::current_tid(), engine.physics_tid()]
         .into_iter()
         .flatten()
-    {
-        cpu_before.push((tid, crate::cpu::thread_cpu_seconds_of(tid).unwrap_or(0.0)));
-    }
-    let parallel_before = engine.parallel_seconds().unwrap_or(0.0);
-    let (wall, max_err) = step_frames(&mut engine, steps, frame, &rel)?;
-    let parallel_seconds = (settings.threading == crate::engine::Threading::Pool)
-        .then(|| engine.parallel_seconds().unwrap_or(0.0) - parallel_before);
-    let physics_threads = engine.physics_threads();
-    let physics_cpu_seconds = physics_cpu(&engine, &physics_threads, &cpu_before);
-    let load_end = load_average();
-    // Read while the engine's threads are still alive.
-    let thread_cpu = crate::cpu::thread_cpu_seconds()
-        .into_iter()
-        .map(|(name, cpu_seconds)| ThreadCpu { name, cpu_seconds })
+        .map(|tid| (tid, crate::cpu::thread_cpu_seconds_of(tid).unwrap_or(0.0)))
         .collect();
+    let parallel_before = engine.parallel_seconds().unwrap_or(0.0);
+    let (wall, max_err) = step_frames(&mut engine, steps, frame, &|e| energy_change(e, e0))?;
+    let physics_threads = engine.physics_threads();
+    let measured = Measured {
+        wall,
+        max_err,
+        parallel_seconds: (settings.threading == crate::engine::Threading::Pool)
+            .then(|| engine.parallel_seconds().unwrap_or(0.0) - parallel_before),
+        physics_cpu_seconds: physics_cpu(&engine, &physics_threads, &cpu_before),
+        physics_threads,
+        load_average: load_start.into_iter().chain(load_average()).collect(),
+        // Read while the engine's threads are still alive.
+        thread_cpu: crate::cpu::thread_cpu_seconds()
+            .into_iter()
+            .map(|(name, cpu_seconds)| ThreadCpu { name, cpu_seconds })
+            .collect(),
+    };
     // The last snapshot's figures are the final world's.
-    let last = engine.snapshot();
-    let (e1, escaped) = (last.energy, last.escaped);
-    let (max_overlap_rel, overlap_partial) = (last.max_overlap_rel, last.overlap_partial);
-    let choice = last.choice.clone();
+    let last = engine.snapshot().clone();
     let world = engine
         .into_world()
         .ok_or_else(|| anyhow::anyhow!("the engine lost its world"))?;
-    let sim = world.time - t_start;
+    let report = report_of(
+        &world,
+        settings,
+        steps,
+        e0,
+        world.time - t_start,
+        measured,
+        &last,
+    );
+    Ok((report, world))
+}
+
+/// The energy's change from `e0`, relative where `e0` is not 0.
+fn energy_change(e: f64, e0: f64) -> f64 {
+    if e0 > 0.0 {
+        (e - e0).abs() / e0
+    } else {
+        (e - e0).abs()
+    }
+}
+
+/// What [`run`] measured while the engine stepped.
+struct Measured {
+    wall: f64,
+    max_err: f64,
+    parallel_seconds: Option<f64>,
+    physics_cpu_seconds: f64,
+    physics_threads: Vec<String>,
+    load_average: Vec<f64>,
+    thread_cpu: Vec<ThreadCpu>,
+}
+
+/// The report of a run of `steps` that took the world from energy `e0`
+/// over `sim` simulated seconds to `world`, `last` its last snapshot.
+fn report_of(
+    world: &World,
+    settings: &Settings,
+    steps: u64,
+    e0: f64,
+    sim: f64,
+    m: Measured,
+    last: &crate::engine::Snapshot,
+) -> BenchReport {
     let n = world.spheres.len();
-    let per_sec = |x: f64| if wall > 0.0 { x / wall } else { 0.0 };
+    let per_sec = |x: f64| if m.wall > 0.0 { x / m.wall } else { 0.0 };
+    let per_sim = |x: f64| if sim > 0.0 { x / sim } else { 0.0 };
     let c = world.counters;
     let area = 6.0 * world.size * world.size;
+    let choice = last.choice.as_ref();
     let report = BenchReport {
         n,
         steps,
         dt: settings.dt,
         model: settings.model.name().to_string(),
-        model_chosen: choice.as_ref().map(|c| c.model.name().to_string()),
-        tolerance_unmet: choice.as_ref().is_some_and(|c| c.unmet),
-        model_reason: choice.map(|c| c.reason),
+        model_chosen: choice.map(|c| c.model.name().to_string()),
+        tolerance_unmet: choice.is_some_and(|c| c.unmet),
+        model_reason: choice.map(|c| c.reason.clone()),
         threading: settings.threading.name().to_string(),
         threads: settings.threads,
-        physics_threads,
-        wall_seconds: wall,
-        physics_cpu_seconds,
-        parallel_seconds,
-        load_average: load_start.into_iter().chain(load_end).collect(),
+        physics_threads: m.physics_threads,
+        wall_seconds: m.wall,
+        physics_cpu_seconds: m.physics_cpu_seconds,
+        parallel_seconds: m.parallel_seconds,
+        load_average: m.load_average,
         steps_per_second: per_sec(steps as f64),
         sphere_steps_per_second: per_sec(steps as f64 * n as f64),
         energy_start: e0,
-        energy_end: e1,
-        energy_drift_rel: rel(e1),
-        max_energy_err_rel: max_err.max(rel(e1)),
-        escaped,
-        max_overlap_rel,
-        overlap_partial,
+        energy_end: last.energy,
+        energy_drift_rel: energy_change(last.energy, e0),
+        max_energy_err_rel: m.max_err.max(energy_change(last.energy, e0)),
+        escaped: last.escaped,
+        max_overlap_rel: last.max_overlap_rel,
+        overlap_partial: last.overlap_partial,
         sphere_collisions: c.sphere_collisions,
         wall_collisions: c.wall_collisions,
-        wall_pressure: if sim > 0.0 {
-            c.wall_momentum / (sim * area)
-        } else {
-            0.0
-        },
-        collisions_per_sim_second: if sim > 0.0 {
-            c.sphere_collisions as f64 / sim
-        } else {
-            0.0
-        },
+        wall_pressure: per_sim(c.wall_momentum / area),
+        collisions_per_sim_second: per_sim(c.sphere_collisions as f64),
         temperature: world.temperature(),
         capped_steps: c.capped_steps,
         budget_steps: c.budget_steps,
-        thread_cpu,
+        thread_cpu: m.thread_cpu,
         peak_rss_bytes: peak_rss_bytes(),
         warnings: Vec::new(),
     };
-    let report = BenchReport {
+    BenchReport {
         warnings: warnings(&report),
         ..report
-    };
-    Ok((report, world))
+    }
 }
 
 /// Run `steps` steps in frames of `frame` steps (the last one shorter):

@@ -50,6 +50,14 @@ pub fn markdown(s: &Sweep) -> String {
         );
     }
     out.push('\n');
+    notes(s, &mut out);
+    out
+}
+
+/// Below the table: a busy host, runs that ended in other bits, the fit
+/// and what it predicts.
+fn notes(s: &Sweep, out: &mut String) {
+    let p = &s.plan;
     if let Some(&start) = s.load_average.first()
         && start >= 0.5 * p.cores as f64
     {
@@ -97,7 +105,6 @@ pub fn markdown(s: &Sweep) -> String {
             "No pool ran on more than one processor, so there is no serial fraction to fit.\n",
         ),
     }
-    out
 }
 
 /// The CSV's columns; `mode` is `predicted` on the rows of the fit's
@@ -165,25 +172,7 @@ pub fn csv(s: &Sweep) -> anyhow::Result<String> {
 /// # Errors
 /// When the file cannot be written.
 pub fn svg(s: &Sweep, path: &Path) -> anyhow::Result<()> {
-    let top = s
-        .rows
-        .iter()
-        .map(|r| r.config.threads)
-        .chain(fit::PREDICT_AT)
-        .max()
-        .unwrap_or(2) as f64;
-    let ymax = s
-        .rows
-        .iter()
-        .map(|r| r.speedup)
-        .chain(s.predictions().iter().map(|p| p.1))
-        .fold(2.0f64, f64::max);
-    let ymin = s
-        .rows
-        .iter()
-        .map(|r| r.speedup)
-        .fold(0.5f64, f64::min)
-        .max(1e-3);
+    let (top, ymin, ymax) = extent(s);
     let root = SVGBackend::new(path, (800, 560)).into_drawing_area();
     root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(&root)
@@ -254,6 +243,31 @@ pub fn svg(s: &Sweep, path: &Path) -> anyhow::Result<()> {
         .draw()?;
     root.present()?;
     Ok(())
+}
+
+/// The plot's reach: the most threads (measured or predicted at), and the
+/// least and most speed-up.
+fn extent(s: &Sweep) -> (f64, f64, f64) {
+    let top = s
+        .rows
+        .iter()
+        .map(|r| r.config.threads)
+        .chain(fit::PREDICT_AT)
+        .max()
+        .unwrap_or(2) as f64;
+    let ymax = s
+        .rows
+        .iter()
+        .map(|r| r.speedup)
+        .chain(s.predictions().iter().map(|p| p.1))
+        .fold(2.0f64, f64::max);
+    let ymin = s
+        .rows
+        .iter()
+        .map(|r| r.speedup)
+        .fold(0.5f64, f64::min)
+        .max(1e-3);
+    (top, ymin, ymax)
 }
 
 fn rows_of(s: &Sweep, mode: Threading) -> impl Iterator<Item = &Row> {

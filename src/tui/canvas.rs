@@ -216,32 +216,32 @@ impl Raster {
                 // Clear the gap on both sides of the disc, then fill it.
                 let (o0, o1) = span(ox * (1.0 - ey * ey).sqrt());
                 for x in (o0..=o1).filter(|x| *x < i0 || *x > i1) {
-                    let k = row + x as usize;
-                    if depth <= self.depth[k] {
-                        self.depth[k] = depth;
-                        self.shade[k] = EMPTY;
-                    }
+                    self.put(row + x as usize, depth, EMPTY, None);
                 }
                 for x in i0..=i1 {
-                    let k = row + x as usize;
-                    if depth <= self.depth[k] {
-                        self.depth[k] = depth;
-                        self.shade[k] = SHADES;
-                        self.level[k] = level;
-                    }
+                    self.put(row + x as usize, depth, SHADES, Some(level));
                 }
             } else {
                 for x in i0..=i1 {
                     let dx = (x as f64 + 0.5 - cx) * irx;
                     let nz = (1.0 - dx * dx - dy * dy).max(0.0).sqrt();
                     let lit = (dx * light[0] + dy * light[1] + nz * light[2]).max(0.0);
-                    let k = row + x as usize;
-                    if depth <= self.depth[k] {
-                        self.depth[k] = depth;
-                        self.shade[k] = 1 + (lit * f64::from(SHADES - 1) + 0.5) as u8;
-                        self.level[k] = level;
-                    }
+                    let shade = 1 + (lit * f64::from(SHADES - 1) + 0.5) as u8;
+                    self.put(row + x as usize, depth, shade, Some(level));
                 }
+            }
+        }
+    }
+
+    /// Pixel `k` of a sphere `depth` away, unless something nearer holds
+    /// it: its shade, and its colour level where it has one.
+    #[inline]
+    fn put(&mut self, k: usize, depth: f32, shade: u8, level: Option<u8>) {
+        if depth <= self.depth[k] {
+            self.depth[k] = depth;
+            self.shade[k] = shade;
+            if let Some(level) = level {
+                self.level[k] = level;
             }
         }
     }
@@ -286,30 +286,39 @@ impl Raster {
     }
 
     fn braille(&self, scene: &Scene, area: Rect, buf: &mut Buffer) {
-        const BITS: [[u32; 2]; 4] = [[0x01, 0x08], [0x02, 0x10], [0x04, 0x20], [0x40, 0x80]];
         for cy in 0..usize::from(area.height) {
             for cx in 0..usize::from(area.width) {
-                let mut bits = 0u32;
-                let mut nearest = (f32::INFINITY, usize::MAX);
-                for (dy, row) in BITS.iter().enumerate() {
-                    for (dx, bit) in row.iter().enumerate() {
-                        let k = (cy * 4 + dy) * self.w + cx * 2 + dx;
-                        if self.shade[k] != EMPTY {
-                            bits |= bit;
-                            if self.depth[k] < nearest.0 {
-                                nearest = (self.depth[k], k);
-                            }
-                        }
-                    }
-                }
+                let (bits, nearest) = self.braille_dots(cx, cy);
                 if bits == 0 {
                     continue;
                 }
                 let cell = &mut buf[(area.x + cx as u16, area.y + cy as u16)];
                 cell.set_char(char::from_u32(0x2800 + bits).unwrap_or(' '));
-                cell.set_fg(self.colour(scene, nearest.1));
+                cell.set_fg(self.colour(scene, nearest));
             }
         }
+    }
+
+    /// The dots of the braille cell at (`cx`, `cy`) (2×4 pixels) as the
+    /// pattern's bits, and the pixel nearest the eye among them (it gives
+    /// the cell its colour).
+    fn braille_dots(&self, cx: usize, cy: usize) -> (u32, usize) {
+        const BITS: [[u32; 2]; 4] = [[0x01, 0x08], [0x02, 0x10], [0x04, 0x20], [0x40, 0x80]];
+        let mut bits = 0u32;
+        let mut nearest = (f32::INFINITY, usize::MAX);
+        for (dy, row) in BITS.iter().enumerate() {
+            for (dx, bit) in row.iter().enumerate() {
+                let k = (cy * 4 + dy) * self.w + cx * 2 + dx;
+                if self.shade[k] == EMPTY {
+                    continue;
+                }
+                bits |= bit;
+                if self.depth[k] < nearest.0 {
+                    nearest = (self.depth[k], k);
+                }
+            }
+        }
+        (bits, nearest.1)
     }
 
     fn blocks(&self, scene: &Scene, area: Rect, buf: &mut Buffer) {
@@ -324,15 +333,7 @@ impl Raster {
                 }
                 let cell = &mut buf[(area.x + cx as u16, area.y + cy as u16)];
                 if mono {
-                    // No colour: brightness as a glyph ramp.
-                    let glyph = if st == EDGE || sb == EDGE {
-                        '+'
-                    } else {
-                        let s = usize::from(st.max(sb));
-                        let i = (s * MONO_RAMP.len()).div_ceil(usize::from(SHADES)) - 1;
-                        char::from(MONO_RAMP[i.min(MONO_RAMP.len() - 1)])
-                    };
-                    cell.set_char(glyph);
+                    cell.set_char(mono_glyph(st, sb));
                     continue;
                 }
                 match (st != EMPTY, sb != EMPTY) {
@@ -354,6 +355,17 @@ impl Raster {
             }
         }
     }
+}
+
+/// Without colour, a half-block cell's brightness as a glyph ramp: the
+/// brighter of its two pixels' shades (`st`, `sb`), or `+` on an edge.
+fn mono_glyph(st: u8, sb: u8) -> char {
+    if st == EDGE || sb == EDGE {
+        return '+';
+    }
+    let s = usize::from(st.max(sb));
+    let i = (s * MONO_RAMP.len()).div_ceil(usize::from(SHADES)) - 1;
+    char::from(MONO_RAMP[i.min(MONO_RAMP.len() - 1)])
 }
 
 // `f64::floor` and `ceil` are library calls on baseline x86-64; these are

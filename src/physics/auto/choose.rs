@@ -232,6 +232,41 @@ pub struct Ask {
     pub readouts: bool,
 }
 
+/// The choice when `exact`'s predicted events a step (`per_step`) come near
+/// its cap or pass it: `swept` where it may run (`swept_ok`: it fits its own
+/// caps and the floor lets it in), else `exact`, saying the tolerance
+/// cannot be met past the cap. `None` well under the cap.
+fn at_exacts_cap(per_step: f64, exact_cap: f64, swept_ok: bool, tol_text: &str) -> Option<Choice> {
+    let swept = |reason: String| Choice {
+        model: ModelKind::Swept,
+        reason,
+        unmet: false,
+    };
+    if per_step <= exact_cap {
+        let near = per_step * EXACT_CAP_MARGIN > exact_cap;
+        return (near && swept_ok).then(|| {
+            swept(format!(
+                "exact may hit its event cap (~{per_step:.0} events a step, cap {exact_cap:.0}); {tol_text}"
+            ))
+        });
+    }
+    // `exact` would end its steps at the cap, in free flight; `swept`
+    // takes every contact within its own cap and budget.
+    Some(if swept_ok {
+        swept(format!(
+            "exact would pass its event cap (~{per_step:.0} events a step > {exact_cap:.0}); {tol_text}"
+        ))
+    } else {
+        Choice {
+            model: ModelKind::Exact,
+            reason: format!(
+                "tolerance cannot be met: ~{per_step:.0} events a step > exact's cap {exact_cap:.0}; {tol_text}"
+            ),
+            unmet: true,
+        }
+    })
+}
+
 /// The cheapest model predicted to keep the tolerance.
 pub fn choose(s: &Summary, ask: Ask) -> Choice {
     let Ask {
@@ -253,35 +288,8 @@ pub fn choose(s: &Summary, ask: Ask) -> Choice {
     let tol_text = format!("tol {tol}");
     let swept_fits = r.contacts.max(0.0) * dt / f64::from(swept_parts.max(1)) < swept_cap
         && swept_work(s, dt, swept_parts) < swept_budget;
-    let near_cap = per_step * EXACT_CAP_MARGIN > exact_cap && per_step <= exact_cap;
-    if near_cap && floor <= 1 && swept_fits {
-        return Choice {
-            model: ModelKind::Swept,
-            reason: format!(
-                "exact may hit its event cap (~{per_step:.0} events a step, cap {exact_cap:.0}); {tol_text}"
-            ),
-            unmet: false,
-        };
-    }
-    if per_step > exact_cap && floor <= 1 && swept_fits {
-        // `exact` would end its steps at the cap, in free flight; `swept`
-        // takes every contact within its own cap and budget.
-        return Choice {
-            model: ModelKind::Swept,
-            reason: format!(
-                "exact would pass its event cap (~{per_step:.0} events a step > {exact_cap:.0}); {tol_text}"
-            ),
-            unmet: false,
-        };
-    }
-    if per_step > exact_cap {
-        return Choice {
-            model: ModelKind::Exact,
-            reason: format!(
-                "tolerance cannot be met: ~{per_step:.0} events a step > exact's cap {exact_cap:.0}; {tol_text}"
-            ),
-            unmet: true,
-        };
+    if let Some(c) = at_exacts_cap(per_step, exact_cap, floor <= 1 && swept_fits, &tol_text) {
+        return c;
     }
     let depth = discrete_overlap(s, dt);
     if floor == 0 && t > 0.0 && DISCRETE_MARGIN * depth <= t && c.discrete < c.swept.min(c.exact) {

@@ -145,104 +145,8 @@ impl Grid {
         self.top.clear();
         let mut depth = 0;
         if n > ALL_PAIRS_MAX {
-            if self.levels.is_empty() {
-                self.levels.push(Level::default());
-            }
-            // The first level's cell comes from a sample of the reaches (a
-            // function of the state only, so the grid, and the order pairs
-            // come out in, never depend on history); then each sphere's
-            // ball and key are made in one pass over the spheres.
-            self.scratch.clear();
-            self.scratch
-                .extend(spheres.iter().step_by(SAMPLE_STRIDE).map(|s| ball(s).1));
-            let max = self.scratch.iter().fold(0.0f64, |m, &r| m.max(r));
-            let want = cell_of_sample(&mut self.scratch, max);
-            let level = &mut self.levels[0];
-            level.shape(size, want, n, true);
-            self.rest.clear();
-            if n >= KEYED_MIN {
-                self.staged = Vec::new();
-                self.build_keyed(spheres, &ball, exec);
-            } else if n < LANES_MIN_SPHERES || exec.lanes() <= 1 {
-                // Under this many spheres, waking other threads costs more
-                // than the sort; the layout is the same for any number of
-                // lanes.
-                self.keys = Vec::new();
-                self.staged.resize(n, Entry::default());
-                // One lane: the cells are counted while staging, so the
-                // table's increments overlap the arithmetic of the balls
-                // and the staged records are read once less.
-                level.cell_start.fill(0);
-                let (mut count, mut reach_max) = (0, 0.0f64);
-                for ((slot, s), id) in self.staged.iter_mut().zip(spheres).zip(0..) {
-                    *slot = level.stage(ball(s), id, &mut self.rest);
-                    if slot.key != WIDE {
-                        level.cell_start[slot.key as usize] += 1;
-                        count += 1;
-                        // Not `f64::max`: see `fill_lanes`.
-                        if slot.ball.reach > reach_max {
-                            reach_max = slot.ball.reach;
-                        }
-                    }
-                }
-                level.fill_lanes(&self.staged[..], exec, Some((count, reach_max)));
-            } else {
-                self.keys = Vec::new();
-                self.staged.resize(n, Entry::default());
-                let blocks = n.div_ceil(BUILD_BLOCK);
-                self.wide.ensure(blocks);
-                let level = &*level;
-                let wide = &self.wide;
-                for_each_chunk(exec, &mut self.staged, BUILD_BLOCK, &|b, chunk| {
-                    let mut wide = wide[b].lock();
-                    wide.clear();
-                    let first = (b * BUILD_BLOCK) as u32;
-                    let mine = chunk.iter_mut().zip(&spheres[b * BUILD_BLOCK..]);
-                    for ((slot, s), id) in mine.zip(first..) {
-                        *slot = level.stage(ball(s), id, &mut wide);
-                    }
-                });
-                self.levels[0].fill_lanes(&self.staged[..], exec, None);
-                for w in &self.wide[..blocks] {
-                    self.rest.extend_from_slice(&w.lock());
-                }
-            }
-            depth = 1;
-            // Coarser levels for what did not fit, serially: they are few.
-            while self.rest.len() > ALL_PAIRS_MAX {
-                if self.levels.len() == depth {
-                    self.levels.push(Level::default());
-                }
-                let max = self.rest.iter().fold(0.0f64, |m, b| m.max(b.0.reach));
-                let want = cell_for(
-                    self.rest.iter().map(|b| b.0.reach),
-                    max,
-                    1,
-                    &mut self.scratch,
-                );
-                let level = &mut self.levels[depth];
-                level.shape(size, want, self.rest.len(), false);
-                let placed: Vec<Entry> = self
-                    .rest
-                    .iter()
-                    .filter(|b| level.fits(b.0.reach))
-                    .map(|&(ball, id)| Entry {
-                        ball,
-                        id,
-                        key: level.key_of(ball.pos),
-                    })
-                    .collect();
-                if placed.is_empty() {
-                    // Balls wider than a one-cell level (the whole box) fit
-                    // no coarser level either: they join the top, tested
-                    // against everything. Without this the loop never ends.
-                    break;
-                }
-                level.fill(&placed);
-                let cell = level.cell;
-                self.rest.retain(|b| 2.0 * b.0.reach > cell);
-                depth += 1;
-            }
+            self.build_first_level(spheres, &ball, exec);
+            depth = self.build_coarse_levels(size);
             self.top.extend_from_slice(&self.rest);
         } else {
             self.top.extend(spheres.iter().zip(0..).map(|(s, i)| {
@@ -251,6 +155,142 @@ impl Grid {
             }));
         }
         self.levels.truncate(depth);
+    }
+
+    /// The first level, sized for the bulk; the balls too wide for it are
+    /// left in `rest`.
+    fn build_first_level<T: Sync>(
+        &mut self,
+        spheres: &[T],
+        ball: &(impl Fn(&T) -> (DVec3, f64) + Sync),
+        exec: &dyn Exec,
+    ) {
+        let n = spheres.len();
+        if self.levels.is_empty() {
+            self.levels.push(Level::default());
+        }
+        // The first level's cell comes from a sample of the reaches (a
+        // function of the state only, so the grid, and the order pairs
+        // come out in, never depend on history); then each sphere's
+        // ball and key are made in one pass over the spheres.
+        self.scratch.clear();
+        self.scratch
+            .extend(spheres.iter().step_by(SAMPLE_STRIDE).map(|s| ball(s).1));
+        let max = self.scratch.iter().fold(0.0f64, |m, &r| m.max(r));
+        let want = cell_of_sample(&mut self.scratch, max);
+        self.levels[0].shape(self.size, want, n, true);
+        self.rest.clear();
+        if n >= KEYED_MIN {
+            self.staged = Vec::new();
+            self.build_keyed(spheres, ball, exec);
+        } else if n < LANES_MIN_SPHERES || exec.lanes() <= 1 {
+            self.build_staged_one_lane(spheres, ball, exec);
+        } else {
+            self.build_staged(spheres, ball, exec);
+        }
+    }
+
+    /// The first level from staged records on one lane. Under
+    /// [`LANES_MIN_SPHERES`], waking other threads costs more than the
+    /// sort; the layout is the same for any number of lanes.
+    fn build_staged_one_lane<T: Sync>(
+        &mut self,
+        spheres: &[T],
+        ball: &(impl Fn(&T) -> (DVec3, f64) + Sync),
+        exec: &dyn Exec,
+    ) {
+        self.keys = Vec::new();
+        self.staged.resize(spheres.len(), Entry::default());
+        let level = &mut self.levels[0];
+        // One lane: the cells are counted while staging, so the table's
+        // increments overlap the arithmetic of the balls and the staged
+        // records are read once less.
+        level.cell_start.fill(0);
+        let (mut count, mut reach_max) = (0, 0.0f64);
+        for ((slot, s), id) in self.staged.iter_mut().zip(spheres).zip(0..) {
+            *slot = level.stage(ball(s), id, &mut self.rest);
+            if slot.key != WIDE {
+                level.cell_start[slot.key as usize] += 1;
+                count += 1;
+                // Not `f64::max`: see `fill_lanes`.
+                if slot.ball.reach > reach_max {
+                    reach_max = slot.ball.reach;
+                }
+            }
+        }
+        level.fill_lanes(&self.staged[..], exec, Some((count, reach_max)));
+    }
+
+    /// The first level from records staged in parallel blocks, the wide
+    /// balls of each block joined in block order.
+    fn build_staged<T: Sync>(
+        &mut self,
+        spheres: &[T],
+        ball: &(impl Fn(&T) -> (DVec3, f64) + Sync),
+        exec: &dyn Exec,
+    ) {
+        let n = spheres.len();
+        self.keys = Vec::new();
+        self.staged.resize(n, Entry::default());
+        let blocks = n.div_ceil(BUILD_BLOCK);
+        self.wide.ensure(blocks);
+        let level = &self.levels[0];
+        let wide = &self.wide;
+        for_each_chunk(exec, &mut self.staged, BUILD_BLOCK, &|b, chunk| {
+            let mut wide = wide[b].lock();
+            wide.clear();
+            let first = (b * BUILD_BLOCK) as u32;
+            let mine = chunk.iter_mut().zip(&spheres[b * BUILD_BLOCK..]);
+            for ((slot, s), id) in mine.zip(first..) {
+                *slot = level.stage(ball(s), id, &mut wide);
+            }
+        });
+        self.levels[0].fill_lanes(&self.staged[..], exec, None);
+        for w in &self.wide[..blocks] {
+            self.rest.extend_from_slice(&w.lock());
+        }
+    }
+
+    /// Coarser levels for what did not fit the first, serially: they are
+    /// few. Returns the levels in all; `rest` keeps the balls wider than
+    /// any level, for the top.
+    fn build_coarse_levels(&mut self, size: f64) -> usize {
+        let mut depth = 1;
+        while self.rest.len() > ALL_PAIRS_MAX {
+            if self.levels.len() == depth {
+                self.levels.push(Level::default());
+            }
+            let max = self.rest.iter().fold(0.0f64, |m, b| m.max(b.0.reach));
+            let want = cell_for(
+                self.rest.iter().map(|b| b.0.reach),
+                max,
+                1,
+                &mut self.scratch,
+            );
+            let level = &mut self.levels[depth];
+            level.shape(size, want, self.rest.len(), false);
+            let placed: Vec<Entry> = self
+                .rest
+                .iter()
+                .filter(|b| level.fits(b.0.reach))
+                .map(|&(ball, id)| Entry {
+                    ball,
+                    id,
+                    key: level.key_of(ball.pos),
+                })
+                .collect();
+            if placed.is_empty() {
+                // Balls wider than a one-cell level (the whole box) fit
+                // no coarser level either: they join the top, tested
+                // against everything. Without this the loop never ends.
+                break;
+            }
+            level.fill(&placed);
+            let cell = level.cell;
+            self.rest.retain(|b| 2.0 * b.0.reach > cell);
+            depth += 1;
+        }
+        depth
     }
 
     /// The first level of [`Grid::build`] from [`KEYED_MIN`] spheres on:

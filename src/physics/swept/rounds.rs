@@ -307,43 +307,7 @@ impl Rounds {
                 self.work += work;
                 let (k0, k1) = (k, k + len as usize);
                 k = k1;
-                // Bystanders that joined a run are its members now.
-                let mut root = Slot::NONE;
-                let mut twice = false;
-                let mut first = None;
-                for at in k0..k1 {
-                    let Some((m, _)) = self.fin.record_in(c, at) else {
-                        unreachable!("a chunk holds the members its runs wrote");
-                    };
-                    let id = m.id;
-                    first.get_or_insert(id);
-                    // A bystander that joined this run may have got a slot
-                    // from an earlier run of this round (or none yet).
-                    let s = match self.part.slot[id as usize] {
-                        Slot::NONE => self.add_slot(id),
-                        s => s,
-                    };
-                    // Joined an earlier run of this round too: the two
-                    // runs join (below) and run again.
-                    twice |= s.index() >= known && self.fin.ran[s.index()] == round;
-                    self.fin.set(s.index(), c, at);
-                    self.fin.capped[s.index()] = capped;
-                    self.fin.ran[s.index()] = round;
-                    root = if root.is_none() {
-                        self.part.find(s)
-                    } else {
-                        self.part.link(root, s)
-                    };
-                }
-                if twice {
-                    self.part.union(root, root);
-                    let Some(first) = first else {
-                        unreachable!("a run that joined another has members");
-                    };
-                    self.conf.found.push((first, first));
-                } else {
-                    self.part.ran(root);
-                }
+                self.take_run(c, k0..k1, capped, known);
             }
             cross.extend_from_slice(&out.cross);
         }
@@ -356,6 +320,53 @@ impl Rounds {
             k > fresh || ran[slot[a as usize].index()] != round
         });
         self.conf.cross = cross;
+    }
+
+    /// One finished run of this round, its members `at` in chunk `c` (of
+    /// `Finished`): each gets its slot (a bystander that joined the run, a
+    /// new one) and its record, and they all join one cluster; when the run
+    /// took a bystander another run of this round took too (slots from
+    /// `known` on are this round's), the two must run again as one.
+    fn take_run(
+        &mut self,
+        c: u32,
+        at: std::ops::Range<usize>,
+        capped: Option<Coarse>,
+        known: usize,
+    ) {
+        let round = self.stats.rounds as u32;
+        let mut root = Slot::NONE;
+        let mut twice = false;
+        let mut first = None;
+        for at in at {
+            let Some((m, _)) = self.fin.record_in(c, at) else {
+                unreachable!("a chunk holds the members its runs wrote");
+            };
+            let id = m.id;
+            first.get_or_insert(id);
+            // A bystander that joined this run may have got a slot from an
+            // earlier run of this round (or none yet).
+            let s = match self.part.slot[id as usize] {
+                Slot::NONE => self.add_slot(id),
+                s => s,
+            };
+            twice |= s.index() >= known && self.fin.ran[s.index()] == round;
+            self.fin.set(s.index(), c, at);
+            self.fin.capped[s.index()] = capped;
+            self.fin.ran[s.index()] = round;
+            root = if root.is_none() {
+                self.part.find(s)
+            } else {
+                self.part.link(root, s)
+            };
+        }
+        match (twice, first) {
+            (true, Some(first)) => {
+                self.part.union(root, root);
+                self.conf.found.push((first, first));
+            }
+            _ => self.part.ran(root),
+        }
     }
 
     fn merge_conflicts(&mut self) {
