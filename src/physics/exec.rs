@@ -85,8 +85,8 @@ pub struct Busy {
 /// The lanes a section of `blocks` blocks and `work` items gets from an
 /// executor of `threads` threads on `cores` cores, a lane wanting
 /// `min_work` items: the least of the four limits, at least one, and which
-/// limit it was (the first that binds, in the order work, blocks,
-/// threads, cores).
+/// limit it was (the first that binds, in the order threads, cores, work,
+/// blocks).
 #[must_use]
 pub fn lanes_for(
     threads: usize,
@@ -95,11 +95,14 @@ pub fn lanes_for(
     work: usize,
     min_work: usize,
 ) -> (usize, Bound) {
+    // When every thread (or core) has a lane, nothing else held it back,
+    // even if the work would allow no more (8 789 spheres on 2 threads is
+    // "2 of 2 busy", not "too few").
     let limits = [
-        (work / min_work.max(1), Bound::Work),
-        (blocks, Bound::Blocks),
         (threads, Bound::Threads),
         (cores, Bound::Cores),
+        (work / min_work.max(1), Bound::Work),
+        (blocks, Bound::Blocks),
     ];
     let least = limits.iter().map(|l| l.0).min().unwrap_or(1).max(1);
     let bound = limits
@@ -241,6 +244,9 @@ mod tests {
         assert_eq!(lanes_for(8, 64, 100, 100 * w, w), (8, Bound::Threads));
         // Work for exactly three lanes.
         assert_eq!(lanes_for(8, 8, 100, 3 * w + 1, w), (3, Bound::Work));
+        // Work for exactly the threads: every one busy, nothing held back.
+        assert_eq!(lanes_for(2, 2, 100, 2 * w + 5, w), (2, Bound::Threads));
+        assert_eq!(lanes_for(64, 2, 100, 2 * w + 5, w), (2, Bound::Cores));
         // Never none, whatever the limits.
         assert_eq!(lanes_for(0, 0, 0, 0, w).0, 1);
         assert_eq!(lanes_for(1, 2, 100, 100 * w, w), (1, Bound::Threads));

@@ -41,7 +41,8 @@ pub fn pool_line(b: &crate::physics::exec::Busy, spheres: usize) -> String {
         Bound::Work => format!("{spheres} spheres too few"),
         Bound::Blocks => "too few blocks".into(),
         Bound::Cores => "one a core".into(),
-        Bound::Threads => "all".into(),
+        // Every thread had a lane: nothing to explain.
+        Bound::Threads => return format!("pool: {} of {} busy", b.busy, b.threads),
     };
     format!("pool: {} of {} busy — {why}", b.busy, b.threads)
 }
@@ -470,6 +471,30 @@ impl Widget for Threads<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_pool_line_says_why_only_when_threads_wait() {
+        use crate::physics::exec::{Bound, Busy, MIN_WORK_PER_LANE, lanes_for};
+        let line = |threads, spheres: usize| {
+            let (busy, bound) = lanes_for(threads, 2, 100, spheres, MIN_WORK_PER_LANE);
+            let b = Busy {
+                busy,
+                threads,
+                bound,
+            };
+            pool_line(&b, spheres)
+        };
+        assert_eq!(line(64, 1000), "pool: 1 of 64 busy — 1000 spheres too few");
+        // Work for two lanes on two threads: all of them busy.
+        assert_eq!(line(2, 8789), "pool: 2 of 2 busy");
+        assert_eq!(line(64, 8789), "pool: 2 of 64 busy — one a core");
+        let b = Busy {
+            busy: 3,
+            threads: 8,
+            bound: Bound::Blocks,
+        };
+        assert_eq!(pool_line(&b, 10), "pool: 3 of 8 busy — too few blocks");
+    }
 
     #[test]
     fn the_grid_doubles_threads_per_cell_until_it_fits() {
