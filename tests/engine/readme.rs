@@ -9,7 +9,7 @@ use ballpit::cli::{Cli, Command, SceneArgs};
 use ballpit::scene::{self, presets};
 use std::path::{Path, PathBuf};
 
-const README: &str = include_str!("../README.md");
+const README: &str = include_str!("../../README.md");
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))

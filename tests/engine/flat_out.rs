@@ -2,12 +2,10 @@
 //! give, for the steps they ran, the same bits as frames of a fixed tick,
 //! in every mode; and every step is inside the physics timer.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
-#[path = "common/bits.rs"]
-mod common;
+use crate::common::bits::bits;
 use ballpit::engine::{Engine, Settings, Threading};
 use ballpit::physics::{ModelKind, World};
 use ballpit::scene::{SceneSpec, build_world};
-use common::bits;
 use std::time::Duration;
 
 fn settings(model: ModelKind, threading: Threading, tick: u32) -> Settings {

@@ -2,11 +2,9 @@
 //! nothing, the idle physics thread sleeps, panics come back as errors, and
 //! count and radius edits keep spheres apart and inside.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
-#[path = "common/bits.rs"]
-mod bits;
+use crate::common::bits::bits;
 use ballpit::engine::{Command, Engine, Settings, Threading};
 use ballpit::physics::{Exec, Model, ModelKind, Sphere, World};
-use bits::bits;
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;

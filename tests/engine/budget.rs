@@ -3,13 +3,11 @@
 //! bounded time, finished in free flight and reported; a capped step is the
 //! same bits on any lanes; a step under its budget is untouched by it.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
-#[path = "common/bits.rs"]
-mod bits;
+use crate::common::bits::bits;
 use ballpit::engine::{PoolExec, SplitExec};
 use ballpit::physics::swept::Swept;
 use ballpit::physics::{Exec, Model, Serial, Sphere, World};
 use ballpit::scene::{SceneSpec, build_world};
-use bits::bits;
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;

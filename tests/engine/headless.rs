@@ -2,11 +2,9 @@
 //! the same figures and the same world as one with a screen, Reset brings
 //! back the start bit for bit, and the screen's single-precision views stay
 //! within rounding of the world.
-#[path = "common/bits.rs"]
-mod bits;
+use crate::common::bits::bits;
 use ballpit::engine::{Command, Engine, Settings, Snapshot, Threading};
 use ballpit::physics::{ModelKind, Sphere, World};
-use bits::bits;
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;

@@ -2,9 +2,7 @@
 //! configuration, the CSV and SVG written, a fitted fraction within [0, 1],
 //! the same bits in every mode, a progress bar on a terminal, and bad input.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
-#[allow(dead_code)] // each test file uses a part of the pty helpers
-#[path = "common/pty.rs"]
-mod pty;
+use crate::common::pty;
 
 use assert_cmd::Command;
 use ballpit::engine::Threading;
