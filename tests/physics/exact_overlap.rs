@@ -4,13 +4,11 @@
 //! the bit, on worlds with overlaps made by hand (an exact run makes none)
 //! and without, and asking for it must change nothing in the physics.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+use crate::common::bits::Lanes;
 use ballpit::physics::exact::{Exact, LISTS_ABOVE_PACKING};
 use ballpit::physics::sphere::volume;
 use ballpit::physics::{Exec, Model, Serial, Sphere, World};
-#[path = "common/bits.rs"]
-mod bits;
 use ballpit::scene::lattice::lattice_world;
-use bits::Lanes;
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;

@@ -1,13 +1,11 @@
 //! The tuned constants of `swept` were chosen on the bench presets; here
 //! they are held on scenes that are not presets.
-#[path = "common/bits.rs"]
-mod bits;
+use crate::common::bits::Lanes;
 use ballpit::physics::broad::Grid;
 use ballpit::physics::sphere::{Sphere, volume};
 use ballpit::physics::swept::{ADDED_PAIRS, Swept};
 use ballpit::physics::{Model, Serial, World};
 use ballpit::scene::{SceneSpec, build_world};
-use bits::Lanes;
 use proptest::prelude::*;
 
 const DT: f64 = 1.0 / 60.0;

@@ -4,15 +4,13 @@
 //! same operations and compares every peek; the model over each gives the
 //! same contacts and final state, bit for bit, on a few scenes.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+use crate::common::large::with_three_large;
 use ballpit::physics::exact::{Calendar, Contact, EventDriven, EventQueue, Tournament};
 use ballpit::physics::{Model, Serial, World};
 use ballpit::scene::lattice::lattice_world;
 use ballpit::scene::{SceneSpec, build_world};
 use glam::DVec3;
 use proptest::prelude::*;
-#[path = "common/large.rs"]
-mod large;
-use large::with_three_large;
 use std::sync::{Arc, Mutex};
 
 #[derive(Clone, Debug)]

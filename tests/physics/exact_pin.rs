@@ -11,14 +11,12 @@
 //! position, so the grid changes the last bits of the positions).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 #![allow(clippy::unreadable_literal)] // pinned hashes, as the failure prints them
+use crate::common::large::with_three_large;
 use ballpit::physics::exact::Exact;
 use ballpit::physics::{Model, Serial, World};
 use ballpit::scene::lattice::lattice_world;
 use ballpit::scene::{SceneSpec, build_world};
 use std::sync::{Arc, Mutex};
-#[path = "common/large.rs"]
-mod large;
-use large::with_three_large;
 
 /// FNV-1a over 64-bit words.
 #[derive(Clone, Copy)]

@@ -2,12 +2,10 @@
 //! result must be the plain serial event loop's, bit for bit, on every kind
 //! of scene, however many lanes run the clusters.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
-#[path = "common/bits.rs"]
-mod bits;
+use crate::common::bits::Lanes;
 use ballpit::physics::swept::Swept;
 use ballpit::physics::{Model, Serial, World};
 use ballpit::scene::{SceneSpec, build_world};
-use bits::Lanes;
 
 fn world(scene: &str, count: usize, speed: Option<f64>) -> World {
     build_world(&SceneSpec {

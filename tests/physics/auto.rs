@@ -2,6 +2,7 @@
 //! scenes, the same bits in every threading mode, and a live edit that
 //! crosses a boundary.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+use crate::common::random_scene::random_scene;
 use ballpit::engine::{Command, Engine, Settings, Threading};
 use ballpit::physics::auto::{Ask, Summary, Tolerance, choose};
 use ballpit::physics::swept::parts;
@@ -11,9 +12,6 @@ use ballpit::scene::{SceneSpec, build_world};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
-#[path = "common/random_scene.rs"]
-mod random_scene;
-use random_scene::random_scene;
 
 const DTS: [f64; 3] = [1.0 / 15.0, 1.0 / 60.0, 1.0 / 1920.0];
 

@@ -2,12 +2,10 @@
 //! same bits on 1, 2, 3, 8, 64 and 256 lanes (all of them used, lanes run
 //! last first) and on real pools of those sizes, as on one thread.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
-#[path = "common/bits.rs"]
-mod bits;
+use crate::common::bits::{Lanes, bits};
 use ballpit::engine::{Engine, Settings, Threading};
 use ballpit::physics::{ModelKind, Serial, World};
 use ballpit::scene::{SceneSpec, build_world, presets::PRESETS};
-use bits::{Lanes, bits};
 
 const COUNTS: [usize; 6] = [1, 2, 3, 8, 64, 256];
 const DT: f64 = 1.0 / 60.0;
