@@ -65,7 +65,7 @@ fn ticked(model: ModelKind, steps: u64) -> World {
 fn flat_out_steps_give_the_bits_of_the_same_steps_in_one_frame() {
     // Not `auto`: it chooses again when the steps per frame change, so a
     // flat-out run and a ticked one may run different models (its bits
-    // across threading modes at one tick are held by tests/auto.rs).
+    // across threading modes at one tick are held by tests/physics/auto.rs).
     for model in ModelKind::FIXED {
         for threading in Threading::ALL {
             let (got, steps, secs) = flat_out(model, threading, 6);

@@ -2,7 +2,7 @@
 //! and run. The scenes lean on the rounding cases: radii and speeds over
 //! many orders of magnitude, spheres placed exactly touching each other and
 //! the walls, equal velocities, zero velocities. More cases:
-//! `PROPTEST_CASES=20000 cargo test --release --test fuzz_exact`.
+//! `PROPTEST_CASES=20000 cargo test --release --test physics fuzz_exact::`.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 #![allow(clippy::format_push_string)] // fuzz inputs read best as format strings
 use ballpit::physics::exact::Exact;
