@@ -1,5 +1,5 @@
 //! The terminal app started as `main` starts it, plus a thread named
-//! `probe-panic` that panics once the first frame is out: `tests/tui_pty.rs`
+//! `probe-panic` that panics once the first frame is out: `tests/app/tui_pty.rs`
 //! checks that the terminal is restored, the message printed after it, and
 //! the exit code a failure. Kept out of the shipped binary.
 //!

@@ -1,4 +1,7 @@
 //! The CPU sampler reads threads by name and agrees with the kernel.
+//! A test binary of its own, not a module of a grouped crate: the sampler
+//! reads this process's threads, and tests run beside it as threads of the
+//! same process would take the CPU its quarter-busy thread is measured on.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use ballpit::cpu::{Sampler, current_tid, thread_cpu_seconds, thread_cpu_seconds_of};
 use std::sync::Arc;

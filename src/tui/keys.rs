@@ -1,5 +1,5 @@
 //! The one key table: dispatch (`lookup`), the `?` overlay, the key
-//! bar and the README check (`tests/readme_keys.rs`) all read `TABLE`, so a
+//! bar and the README check (`tests/app/readme_keys.rs`) all read `TABLE`, so a
 //! key cannot be added in one place and forgotten in another.
 
 /// What a key asks for; `TABLE` binds the keys to them.

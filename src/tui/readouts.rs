@@ -91,7 +91,7 @@ const FULL_ROWS: u16 = 16;
 const COMPACT_ROWS: u16 = 7;
 /// Rows kept for a notice, so a long one wraps instead of being cut (every
 /// notice of bounded length fits two rows of the narrowest panel,
-/// `tests/notices.rs`; a longer one takes rows from the threads).
+/// `tests/app/notices.rs`; a longer one takes rows from the threads).
 pub const NOTICE_ROWS: u16 = 2;
 /// The full panel: its rows, the notice and the border.
 pub const HEIGHT: u16 = FULL_ROWS + NOTICE_ROWS + 2;

@@ -1,7 +1,5 @@
 //! What the physics tests compare to the bit, shared by the test files that
 //! hold results identical across executors, budgets and engines.
-// Each test file uses a part of it.
-#![allow(dead_code)]
 use ballpit::physics::{Exec, World};
 
 /// Every number of the state, as bits: the box, the time, every counter and

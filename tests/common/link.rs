@@ -3,7 +3,7 @@
 //! one-way delay each way, feeds it to a vt100 screen, and answers the
 //! device status query (`ESC[5n` → `ESC[0n`), cursor position (`ESC[6n`)
 //! and device attributes (`ESC[c`) only once it has consumed the bytes before
-//! them, as a real terminal does. Shared by `tests/slow_link.rs` and
+//! them, as a real terminal does. Shared by `tests/app/slow_link.rs` and
 //! `examples/slow_link.rs`.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 #![allow(dead_code)]

@@ -1,4 +1,4 @@
-//! Random scenes for `auto`: the accuracy sweep in `tests/auto.rs` and the
+//! Random scenes for `auto`: the accuracy sweep in `tests/physics/auto.rs` and the
 //! cost sweep of `examples/auto_sweep.rs` draw from the same generator.
 use ballpit::physics::{Sphere, World};
 use glam::DVec3;

@@ -33,7 +33,7 @@
 //! `dt` is only the sampling interval: on return, every position is exact at
 //! `world.time`.
 //!
-//! **Bounds** (asserted in `tests/extremes.rs` and `tests/fuzz_exact.rs`):
+//! **Bounds** (asserted in `tests/physics/extremes.rs` and `tests/physics/fuzz_exact.rs`):
 //! energy is conserved to rounding (relative error below `1e-10` in the
 //! extreme cases; `benches/exact.rs` measures about `4e-14` over 10 million
 //! collisions); overlap is below `1e-9` of the smaller radius; no sphere

@@ -2,7 +2,7 @@
 //! in space ([`super::spatial`]); as they drift, [`EventDriven::renumber`]
 //! sorts them again (when asked: `with_renumbering(true)`; at 100k and 1M
 //! spheres it cost more than it saved, see docs/benchmarks.md "exact at
-//! scale"). The pins of `tests/exact_pin.rs` run with it on, so they hold
+//! scale"). The pins of `tests/physics/exact_pin.rs` run with it on, so they hold
 //! it to changing nothing.
 //! Only labels change: every record moves with its sphere and keeps its
 //! value (and each cell and list keeps its order), and `order` maps the
