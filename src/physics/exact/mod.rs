@@ -63,6 +63,7 @@ use super::contact::{reflect_walls, resolve_pair};
 use super::exec::Exec;
 use super::flight::fly;
 use super::model::{Model, ModelKind};
+use super::sphere::Sphere;
 use super::world::{Counters, World};
 use body::Bodies;
 #[cfg(feature = "experiments")]
@@ -297,12 +298,13 @@ impl<Q: EventQueue> EventDriven<Q> {
         }
     }
 
-    /// Cell mode: the earlier of the pending event and the next crossing
-    /// (the crossing first on a tie), marked in the slot; returns its time.
+    /// The earlier of the pending event and the next crossing (the crossing
+    /// first on a tie), marked in the slot; returns its time. Only cells
+    /// have crossings: with neighbour lists the pending event stands.
     #[inline]
     fn with_crossing(&mut self, i: Label) -> f64 {
         let Broad::Cells(cells) = &self.broad else {
-            unreachable!("crossings only in cell mode")
+            return self.slots[i.index()].t;
         };
         let a = &self.bodies[i];
         let (tc, ev) = cells.next_event(i, a);
@@ -332,7 +334,9 @@ impl<Q: EventQueue> EventDriven<Q> {
             return;
         }
         let Broad::Cells(cells) = &self.broad else {
-            unreachable!("crossings only in cell mode")
+            // Only cells have crossings; any other broad phase predicts anew.
+            self.schedule(i);
+            return;
         };
         let a = &self.bodies[i];
         let mut p = Predictor::resume(a, &self.bodies, tp - a.t, evp);
@@ -402,16 +406,7 @@ impl<Q: EventQueue> EventDriven<Q> {
                     self.stats.walls += 1;
                     let mut s = self.bodies.sphere(i);
                     let mask = [ev.mask & 1 != 0, ev.mask & 2 != 0, ev.mask & 4 != 0];
-                    for (k, &hit) in mask.iter().enumerate() {
-                        if hit && s.vel[k] != 0.0 {
-                            // On the wall exactly: lazy positions never drift out.
-                            s.pos[k] = if s.vel[k] < 0.0 {
-                                s.radius
-                            } else {
-                                self.size - s.radius
-                            };
-                        }
-                    }
+                    onto_walls(&mut s, mask, self.size);
                     let (imp, hits) = reflect_walls(&mut s, mask);
                     let b = &mut self.bodies[i];
                     b.pos = s.pos;
@@ -436,7 +431,9 @@ impl<Q: EventQueue> EventDriven<Q> {
                     }
                     self.after_crossing(i, ev.mask);
                 }
-                Kind::Idle => unreachable!("idle spheres have no finite event time"),
+                // An idle sphere's time is infinite: it is never popped
+                // before the end of a step, and nothing happens to it.
+                Kind::Idle => {}
             }
         }
     }
@@ -533,5 +530,19 @@ impl<Q: EventQueue + Send> Model for EventDriven<Q> {
             self.load(world);
         }
         Some(self.deepest_overlap(exec))
+    }
+}
+
+/// A sphere at a wall event, put on the walls of the axes it hits exactly:
+/// lazy positions never drift out.
+fn onto_walls(s: &mut Sphere, mask: [bool; 3], size: f64) {
+    for (k, &hit) in mask.iter().enumerate() {
+        if hit && s.vel[k] != 0.0 {
+            s.pos[k] = if s.vel[k] < 0.0 {
+                s.radius
+            } else {
+                size - s.radius
+            };
+        }
     }
 }
