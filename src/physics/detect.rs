@@ -53,12 +53,9 @@ impl Detection {
             for_each_block_of(exec, blocks, n, &|b| {
                 let mut v = slots[b].lock();
                 v.clear();
-                let end = ((b + 1) * SPHERE_BLOCK).min(n);
-                for (i, s) in spheres[b * SPHERE_BLOCK..end].iter().enumerate() {
-                    if wall(s) {
-                        v.push((b * SPHERE_BLOCK + i) as u32);
-                    }
-                }
+                let (start, end) = (b * SPHERE_BLOCK, ((b + 1) * SPHERE_BLOCK).min(n));
+                let near_walls = (start..end).filter(|&i| wall(&spheres[i]));
+                v.extend(near_walls.map(|i| i as u32));
             });
         };
         if exec.functional() {

@@ -74,22 +74,16 @@ impl FreeSpace {
             return false;
         }
         let k = self.key(pos);
-        (-1..=1).all(|dx| {
-            (-1..=1).all(|dy| {
-                (-1..=1).all(|dz| {
-                    let mut j = self
-                        .last
-                        .get(&[k[0] + dx, k[1] + dy, k[2] + dz])
-                        .map_or(NO_SPHERE, |&j| j);
-                    while j != NO_SPHERE {
-                        if !clear(j) {
-                            return false;
-                        }
-                        j = self.next[j as usize];
-                    }
-                    true
-                })
-            })
+        let mut cells = (0..27).map(|c| [k[0] + c / 9 - 1, k[1] + c / 3 % 3 - 1, k[2] + c % 3 - 1]);
+        cells.all(|cell| {
+            let mut j = self.last.get(&cell).map_or(NO_SPHERE, |&j| j);
+            while j != NO_SPHERE {
+                if !clear(j) {
+                    return false;
+                }
+                j = self.next[j as usize];
+            }
+            true
         })
     }
 

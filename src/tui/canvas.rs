@@ -4,7 +4,7 @@
 use super::projection::{Camera, Projection};
 use super::theme::{Palette, Ramp};
 use crate::engine::SphereView;
-use ratatui::buffer::Buffer;
+use ratatui::buffer::{Buffer, Cell};
 use ratatui::layout::Rect;
 use ratatui::style::Color;
 use strum::IntoStaticStr;
@@ -343,14 +343,7 @@ impl Raster {
                     (false, true) => {
                         cell.set_char('▄').set_fg(self.colour(scene, bot));
                     }
-                    _ => {
-                        let (ct, cb) = (self.colour(scene, top), self.colour(scene, bot));
-                        if ct == cb {
-                            cell.set_char('█').set_fg(ct);
-                        } else {
-                            cell.set_char('▀').set_fg(ct).set_bg(cb);
-                        }
-                    }
+                    _ => both_halves(cell, self.colour(scene, top), self.colour(scene, bot)),
                 }
             }
         }
@@ -391,6 +384,16 @@ fn light_dir(step: u8) -> [f64; 3] {
     [x / n, y / n, z / n]
 }
 
+/// A cell whose two halves both hold a sphere: one full block when they
+/// share a colour.
+fn both_halves(cell: &mut Cell, top: Color, bottom: Color) {
+    if top == bottom {
+        cell.set_char('█').set_fg(top);
+    } else {
+        cell.set_char('▀').set_fg(top).set_bg(bottom);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -407,6 +410,12 @@ mod tests {
             palette: Palette::C16,
             aspect: 2.0,
         }
+    }
+
+    /// The lit pixels (neither empty nor an edge), as (x, y, shade).
+    fn lit(r: &Raster) -> impl Iterator<Item = (usize, usize, u8)> + '_ {
+        let all = (0..r.h).flat_map(move |y| (0..r.w).map(move |x| (x, y, r.shade[y * r.w + x])));
+        all.filter(|&(_, _, v)| v != EMPTY && v != EDGE)
     }
 
     fn sphere(pos: [f64; 3], radius: f64, speed: f64) -> SphereView {
@@ -427,15 +436,7 @@ mod tests {
             let mut buf = Buffer::empty(area);
             r.draw(&[sphere([0.5, 0.5, 0.5], 0.2, 1.0)], &sc, area, &mut buf);
             // Width and height of the lit region, in cell widths.
-            let (mut xs, mut ys) = (Vec::new(), Vec::new());
-            for y in 0..r.h {
-                for x in 0..r.w {
-                    if r.shade[y * r.w + x] != EMPTY && r.shade[y * r.w + x] != EDGE {
-                        xs.push(x);
-                        ys.push(y);
-                    }
-                }
-            }
+            let (xs, ys): (Vec<usize>, Vec<usize>) = lit(&r).map(|(x, y, _)| (x, y)).unzip();
             let wide = (xs.iter().max().unwrap() - xs.iter().min().unwrap() + 1) as f64 * 0.5;
             let tall =
                 (ys.iter().max().unwrap() - ys.iter().min().unwrap() + 1) as f64 * aspect / 4.0;
@@ -489,14 +490,9 @@ mod tests {
         let s = [sphere([0.5, 0.5, 0.5], 0.25, 0.0)];
         let mean_x = |r: &Raster| {
             let (mut sum, mut wsum) = (0.0, 0.0);
-            for y in 0..r.h {
-                for x in 0..r.w {
-                    let v = r.shade[y * r.w + x];
-                    if v != EMPTY && v != EDGE {
-                        sum += x as f64 * f64::from(v);
-                        wsum += f64::from(v);
-                    }
-                }
+            for (x, _, v) in lit(r) {
+                sum += x as f64 * f64::from(v);
+                wsum += f64::from(v);
             }
             sum / wsum
         };

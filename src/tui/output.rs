@@ -160,13 +160,14 @@ impl<W: Write> Backend for Lean<W> {
                 self.bg = Color::Reset;
                 self.modifier = Modifier::empty();
             }
-            for (m, code) in MODIFIER_CODES {
-                if cell.modifier.contains(m) && !self.modifier.contains(m) {
-                    if !sgr.is_empty() {
-                        sgr.push(';');
-                    }
-                    let _ = write!(sgr, "{code}");
+            let switched_on = MODIFIER_CODES
+                .into_iter()
+                .filter(|&(m, _)| cell.modifier.contains(m) && !self.modifier.contains(m));
+            for (_, code) in switched_on {
+                if !sgr.is_empty() {
+                    sgr.push(';');
                 }
+                let _ = write!(sgr, "{code}");
             }
             self.modifier = cell.modifier;
             let (fg, bg) = if self.colours {

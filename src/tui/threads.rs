@@ -366,9 +366,9 @@ impl Threads<'_> {
             for (start, cells) in rows {
                 let mut spans = vec![Span::styled(start, label)];
                 for (i, (ch, load)) in cells.into_iter().enumerate() {
-                    if i > 0 && i % BLOCK == 0 {
-                        spans.push(Span::raw(" "));
-                    }
+                    // A gap between blocks of cells, for counting.
+                    let gap = (i > 0 && i % BLOCK == 0).then(|| Span::raw(" "));
+                    spans.extend(gap);
                     spans.push(Span::styled(ch.to_string(), self.load_style(load)));
                 }
                 lines.push(Line::from(spans));

@@ -61,15 +61,25 @@ fn states() -> Vec<AppState> {
                     let mut st = AppState::new(&settings(model, threading), 300, 0.004, 30.0);
                     (st.paused, st.flat_out, st.chart) =
                         (flags & 1 != 0, flags & 2 != 0, flags & 4 != 0);
-                    (st.threads, st.tick, st.count, st.radius, st.fps) = match limit {
-                        0 => (1, 0, 1, MIN_RADIUS * 1.1, FPS_STEPS[0]),
-                        1 => (MAX_THREADS, MAX_TICK, MAX_KEY_COUNT, 1.0, FPS_STEPS[6]),
-                        _ => (MAX_THREADS - 1, MAX_TICK - 1, MAX_KEY_COUNT / 2, 0.5, 60.0),
-                    };
-                    st.style = if limit == 2 {
-                        DrawStyle::Shaded
-                    } else {
-                        DrawStyle::PointsSpeed
+                    let (points, shaded) = (DrawStyle::PointsSpeed, DrawStyle::Shaded);
+                    (st.threads, st.tick, st.count, st.radius, st.fps, st.style) = match limit {
+                        0 => (1, 0, 1, MIN_RADIUS * 1.1, FPS_STEPS[0], points),
+                        1 => (
+                            MAX_THREADS,
+                            MAX_TICK,
+                            MAX_KEY_COUNT,
+                            1.0,
+                            FPS_STEPS[6],
+                            points,
+                        ),
+                        _ => (
+                            MAX_THREADS - 1,
+                            MAX_TICK - 1,
+                            MAX_KEY_COUNT / 2,
+                            0.5,
+                            60.0,
+                            shaded,
+                        ),
                     };
                     out.push(st);
                 }

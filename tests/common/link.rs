@@ -62,7 +62,11 @@ fn sleep_until(t: Instant) {
 const QUERIES: [&[u8]; 3] = [b"\x1b[5n", b"\x1b[6n", b"\x1b[c"];
 
 impl Link {
-    #[allow(clippy::too_many_lines)] // the link's three threads, set up in one place
+    #[allow(clippy::too_many_lines)]
+    // the link's three threads, set up in one place
+    // Each end of the link is a thread; the far one scans every chunk for
+    // the terminal queries it answers.
+    #[allow(clippy::excessive_nesting)]
     pub fn start(mut cmd: CommandBuilder, spec: Spec) -> Link {
         let pty = native_pty_system()
             .openpty(PtySize {
@@ -163,14 +167,7 @@ impl Link {
                             p.process(&all[done..end]);
                             done = end;
                             if spec.answers {
-                                let answer = match q[q.len() - 1] {
-                                    b'n' if q[2] == b'5' => b"\x1b[0n".to_vec(),
-                                    b'n' => {
-                                        let (r, c) = p.screen().cursor_position();
-                                        format!("\x1b[{};{}R", r + 1, c + 1).into_bytes()
-                                    }
-                                    _ => b"\x1b[?62;22c".to_vec(),
-                                };
+                                let answer = answer_to(q, p.screen());
                                 ans.fetch_add(1, Ordering::Relaxed);
                                 let _ = up2.send((Instant::now() + delay, answer));
                             }
@@ -319,4 +316,17 @@ pub fn summary(lat: &[Duration]) -> (Duration, Duration) {
         v[v.len() / 2]
     };
     (median, *v.last().unwrap())
+}
+
+/// What a terminal answers to query `q` (status, cursor position, device
+/// attributes).
+fn answer_to(q: &[u8], screen: &vt100::Screen) -> Vec<u8> {
+    match q[q.len() - 1] {
+        b'n' if q[2] == b'5' => b"\x1b[0n".to_vec(),
+        b'n' => {
+            let (r, c) = screen.cursor_position();
+            format!("\x1b[{};{}R", r + 1, c + 1).into_bytes()
+        }
+        _ => b"\x1b[?62;22c".to_vec(),
+    }
 }

@@ -161,7 +161,9 @@ impl Level {
     /// (made while staging), with (how many, widest reach). A source
     /// without `records` is placed through the index arrays, and its keys'
     /// reaches are not read (the caller keeps the widest).
-    #[allow(clippy::too_many_lines)] // the two passes of one sort, sharing their tables
+    // The two passes of one sort, sharing their tables, each a loop over its
+    // lane's keys in a closure per lane.
+    #[allow(clippy::too_many_lines, clippy::excessive_nesting)]
     pub(super) fn fill_lanes<S: Source + ?Sized>(
         &mut self,
         staged: &S,
@@ -296,6 +298,7 @@ impl Level {
     /// Same-level pairs with a sphere in key block `b`, each found once: a
     /// sphere against the rest of its cell and the next cell along x, and the
     /// cells x-1..=x+1 of the four forward rows.
+    #[allow(clippy::excessive_nesting)] // the hot kernel's loops, fused by hand (perf-log.md)
     pub(super) fn block_pairs(
         &self,
         b: usize,
@@ -398,6 +401,7 @@ impl Level {
     }
 
     /// Indices of the spheres in the cells covering `p ± span`.
+    #[allow(clippy::excessive_nesting)] // rows of a box of cells, batched by hand for the hot path
     pub(super) fn near(&self, p: DVec3, span: f64, f: &mut impl FnMut(usize)) {
         if self.entries.len() <= 1 {
             return;

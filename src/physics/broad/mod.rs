@@ -371,19 +371,12 @@ impl Grid {
         match unit {
             Unit::Block { level, block } => self.levels[level].block_pairs(block, go, f),
             Unit::Cross { level, from, to } => {
-                let coarse = &self.levels[level];
-                for e in &coarse.entries[from..to] {
+                for e in &self.levels[level].entries[from..to] {
                     if !go() {
                         return;
                     }
-                    let (a, ia) = (&e.ball, e.id);
                     for finer in &self.levels[..level] {
-                        finer.near(a.pos, a.reach + finer.reach_max, &mut |j| {
-                            let b = &finer.entries[j];
-                            if within(a, &b.ball) {
-                                f(ia, b.id);
-                            }
-                        });
+                        finer_pairs(finer, &e.ball, e.id, f);
                     }
                 }
             }
@@ -393,18 +386,10 @@ impl Grid {
                         return;
                     }
                     for level in &self.levels {
-                        level.near(a.pos, a.reach + level.reach_max, &mut |j| {
-                            let b = &level.entries[j];
-                            if within(a, &b.ball) {
-                                f(*ia, b.id);
-                            }
-                        });
+                        finer_pairs(level, a, *ia, f);
                     }
-                    for (b, ib) in &self.top[k + 1..] {
-                        if within(a, b) {
-                            f(*ia, *ib);
-                        }
-                    }
+                    let above = self.top[k + 1..].iter().filter(|(b, _)| within(a, b));
+                    above.for_each(|(_, ib)| f(*ia, *ib));
                 }
             }
         }
@@ -511,16 +496,18 @@ impl Grid {
                 }
                 !over.get()
             };
+            let mut take = |i, j| {
+                if !keep(i, j) {
+                    return;
+                }
+                if let Some(v) = &mut v {
+                    v.push((i, j));
+                }
+                mine.set(mine.get() + 1);
+            };
             over.set(found.load(Ordering::Relaxed) > limit);
             if go() {
-                this.unit_pairs(units[u], &go, &mut |i, j| {
-                    if keep(i, j) {
-                        if let Some(v) = &mut v {
-                            v.push((i, j));
-                        }
-                        mine.set(mine.get() + 1);
-                    }
-                });
+                this.unit_pairs(units[u], &go, &mut take);
             }
             tell();
         });
@@ -604,4 +591,15 @@ pub fn for_each_near_pair(spheres: &[Sphere], size: f64, mut f: impl FnMut(usize
     for (i, j) in out {
         f(i as usize, j as usize);
     }
+}
+
+/// The pairs of ball `a` (sphere `ia`) with the balls of a finer level.
+#[inline]
+fn finer_pairs(finer: &Level, a: &Ball, ia: u32, f: &mut impl FnMut(u32, u32)) {
+    finer.near(a.pos, a.reach + finer.reach_max, &mut |j| {
+        let b = &finer.entries[j];
+        if within(a, &b.ball) {
+            f(ia, b.id);
+        }
+    });
 }

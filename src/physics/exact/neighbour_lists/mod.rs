@@ -313,6 +313,7 @@ impl NeighbourLists {
     }
 
     /// Find the neighbours `j` of `i` (with `want(j)`) and link both ways.
+    #[allow(clippy::excessive_nesting)] // a box of cells, z, y, x, each cell's spheres in a closure
     fn scan(&mut self, i: Label, bodies: &Bodies, want: impl Fn(Label) -> bool) {
         let ci = self.centre[i.index()].pos;
         let ri = bodies.radius(i) + 2.0 * self.skin;
