@@ -31,6 +31,56 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 20, ..ProptestConfig::default() })]
+    /// A bulk of small balls with a tail a few times wider: the bulk's cells
+    /// are sized for it, the tail goes up a level.
+    #[test]
+    fn tailed_grid_pairs_match_brute_force(
+        balls in proptest::collection::vec(
+            ((0.0f64..1.0, 0.0f64..1.0, 0.0f64..1.0), prop_oneof![16 => 0.002f64..0.004, 1 => 0.01f64..0.05]),
+            500..1500,
+        ),
+    ) {
+        check(&balls)?;
+    }
+}
+
+/// The bulk's cells follow the bulk, not a wide tail: a twenty-fifth of the
+/// balls ten times wider would make every cell of a level sized by them
+/// hold tens of times the candidates.
+#[test]
+fn a_wide_tail_does_not_size_the_bulks_cells() {
+    let n = 20_000;
+    let at = |k: usize| {
+        let f = |m: usize| ((k * m + 7) % 10_007) as f64 / 10_007.0;
+        DVec3::new(f(7_919), f(104_729), f(1_299_709))
+    };
+    let bulk: Vec<Sphere> = (0..n)
+        .map(|k| Sphere::new(at(k), DVec3::ZERO, 0.004))
+        .collect();
+    // Every 25th ball wide: one sample in 25 too (the grid samples every
+    // 32nd), past the 90th percentile and at the 98th.
+    let mut tailed = bulk.clone();
+    for s in tailed.iter_mut().step_by(25) {
+        s.radius = 0.04;
+    }
+    let shape = |s: &[Sphere]| {
+        let mut grid = Grid::default();
+        grid.build(s, 1.0, |b| (b.pos, b.radius), &Serial);
+        grid.shape()
+    };
+    let (plain, _) = shape(&bulk);
+    let (with_tail, _) = shape(&tailed);
+    assert_eq!(plain.len(), 1, "one level for equal balls: {plain:?}");
+    assert_eq!(
+        with_tail[0].0, plain[0].0,
+        "the bulk's cells as without the tail: {with_tail:?} against {plain:?}"
+    );
+    assert!(with_tail.len() >= 2, "the tail goes up: {with_tail:?}");
+    assert_eq!(with_tail[0].1, n - n / 25, "the bulk stays: {with_tail:?}");
+}
+
 fn check(balls: &[((f64, f64, f64), f64)]) -> Result<(), TestCaseError> {
     let spheres: Vec<Sphere> = balls
         .iter()

@@ -23,6 +23,13 @@ const ALL_PAIRS_MAX: usize = 24;
 const LANES_MIN_SPHERES: usize = 4096;
 /// Spheres per parallel block while binning.
 const BUILD_BLOCK: usize = 4096;
+/// A level's cell is sized for its 90th percentile reach, not its 98th,
+/// when the 98th is this many times wider: a cell's candidates grow with its
+/// volume, and cells four times the bulk's (1.6³) for the widest tenth cost
+/// every sphere of the level more than those few cost a level up (a scene
+/// whose light spheres outran its heavy ones 10× spent two thirds of its
+/// step in crowded cells; docs/perf-log.md, 2026-12-04).
+const TAIL_SPREAD: f64 = 1.6;
 /// The first level's cell comes from every this-many-th reach.
 const SAMPLE_STRIDE: usize = 32;
 /// From this many spheres on, the first level is staged as cell keys alone
@@ -82,7 +89,8 @@ impl<T: Sync, B: Fn(&T) -> (DVec3, f64) + Sync> Source for Keyed<'_, T, B> {
 /// Twice the 98th percentile of `reach` (estimated on every `stride`-th
 /// value: a function of the state only, so the grid, and the order pairs
 /// come out in, never depend on history), or twice `max` when the fastest is
-/// close to the bulk.
+/// close to the bulk, or twice the 90th percentile when the top tenth
+/// spreads past [`TAIL_SPREAD`] times it.
 fn cell_for(
     reaches: impl Iterator<Item = f64>,
     max: f64,
@@ -102,7 +110,15 @@ fn cell_of_sample(scratch: &mut [f64], max: f64) -> f64 {
         return 2.0 * max;
     }
     let k = (scratch.len() * 98 / 100).min(scratch.len() - 1);
-    let q = *scratch.select_nth_unstable_by(k, f64::total_cmp).1;
+    let mut q = *scratch.select_nth_unstable_by(k, f64::total_cmp).1;
+    // Everything below `k` is at most `q`: the 90th percentile is there.
+    let k90 = scratch.len() * 90 / 100;
+    if k90 < k {
+        let q90 = *scratch[..k].select_nth_unstable_by(k90, f64::total_cmp).1;
+        if q > TAIL_SPREAD * q90 {
+            q = q90;
+        }
+    }
     // When the fastest is close to the bulk, one level holds everyone.
     2.0 * if max <= 1.25 * q { max } else { q }
 }
