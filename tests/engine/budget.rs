@@ -4,6 +4,7 @@
 //! same bits on any lanes; a step under its budget is untouched by it.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use crate::common::bits::bits;
+use crate::common::json;
 use ballpit::engine::{PoolExec, SplitExec};
 use ballpit::physics::swept::Swept;
 use ballpit::physics::{Exec, Model, Serial, Sphere, World};
@@ -12,52 +13,11 @@ use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::fmt::Write as _;
-use std::io::Read;
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// Today's code took minutes for each of these steps; the budget ends them
 /// in a second or two. A run past this is killed and fails.
 const DEADLINE: Duration = Duration::from_mins(1);
-
-/// `ballpit bench` with `args`, killed at [`DEADLINE`]; its JSON.
-fn bench(args: &[&str]) -> serde_json::Value {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_ballpit"))
-        .arg("bench")
-        .args(args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let start = Instant::now();
-    let status = loop {
-        if let Some(status) = child.try_wait().unwrap() {
-            break status;
-        }
-        if start.elapsed() > DEADLINE {
-            child.kill().unwrap();
-            child.wait().unwrap();
-            panic!("bench {args:?} still running after {DEADLINE:?}");
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    };
-    let (mut out, mut err) = (String::new(), String::new());
-    child
-        .stdout
-        .take()
-        .unwrap()
-        .read_to_string(&mut out)
-        .unwrap();
-    child
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut err)
-        .unwrap();
-    assert!(status.success(), "bench {args:?}: {status} {err}");
-    eprintln!("bench {args:?}: {:.1?}", start.elapsed());
-    serde_json::from_str(&out).unwrap()
-}
 
 /// One step, finished coarsely by the budget and said so; energy kept,
 /// nobody out of the box.
@@ -79,7 +39,10 @@ fn assert_budget_step(v: &serde_json::Value) {
 #[test]
 fn a_step_across_the_box_ends_within_its_budget() {
     // 10^4 box lengths a second: every path crosses the box 170 times.
-    assert_budget_step(&bench(&["--steps", "1", "--speed", "1e4"]));
+    assert_budget_step(&json::bench_within(
+        &["--steps", "1", "--speed", "1e4"],
+        DEADLINE,
+    ));
 }
 
 /// 864 spheres on a face-centred cubic lattice filling the box (packing
@@ -116,7 +79,10 @@ fn lattice_csv(sigma: f64) -> String {
 fn a_fast_close_packed_lattice_ends_within_its_budget() {
     let path = std::env::temp_dir().join(format!("ballpit-budget-{}.csv", std::process::id()));
     std::fs::write(&path, lattice_csv(100.0)).unwrap();
-    let v = bench(&["--steps", "1", "--scene", path.to_str().unwrap()]);
+    let v = json::bench_within(
+        &["--steps", "1", "--scene", path.to_str().unwrap()],
+        DEADLINE,
+    );
     std::fs::remove_file(&path).unwrap();
     assert_eq!(v["n"], 864);
     assert_budget_step(&v);

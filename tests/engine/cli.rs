@@ -1,24 +1,15 @@
 //! The binary's command line: bench JSON, --dump, and bad input (exit 2).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+use crate::common::json;
 use assert_cmd::Command;
 
 fn ballpit() -> Command {
     Command::cargo_bin("ballpit").unwrap()
 }
 
-fn json(args: &[&str]) -> serde_json::Value {
-    let out = ballpit().arg("bench").args(args).output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
-}
-
 #[test]
 fn bench_prints_one_json_line_with_every_field() {
-    let v = json(&["--steps", "30", "--count", "200"]);
+    let v = json::bench(&["--steps", "30", "--count", "200"]);
     for field in [
         "n",
         "steps",
@@ -58,7 +49,7 @@ fn bench_prints_one_json_line_with_every_field() {
 
 #[test]
 fn an_empty_box_reads_zero_not_minus_zero() {
-    let v = json(&["--steps", "3", "--count", "0"]);
+    let v = json::bench(&["--steps", "3", "--count", "0"]);
     assert_eq!(v["n"], 0);
     for field in [
         "energy_start",
@@ -80,7 +71,7 @@ fn dump_reads_back_as_the_same_scene() {
     // Upper case reads as the same file type, as the screen's check has it.
     let a = dir.join("a.csv");
     let b = dir.join("B.CSV");
-    json(&[
+    json::bench(&[
         "--scene",
         "billiards",
         "--steps",
@@ -89,7 +80,7 @@ fn dump_reads_back_as_the_same_scene() {
         a.to_str().unwrap(),
     ]);
     // Zero steps from the dump must write it back byte for byte.
-    let v = json(&[
+    let v = json::bench(&[
         "--scene",
         a.to_str().unwrap(),
         "--steps",
@@ -99,7 +90,7 @@ fn dump_reads_back_as_the_same_scene() {
     ]);
     assert_eq!(v["n"], 8);
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
-    let v = json(&["--scene", b.to_str().unwrap(), "--steps", "0"]);
+    let v = json::bench(&["--scene", b.to_str().unwrap(), "--steps", "0"]);
     assert_eq!(v["n"], 8);
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -252,7 +243,7 @@ fn bench_runs_every_threading_mode_to_the_same_bits() {
         ("split", "physics"),
     ] {
         let path = dir.join(format!("{mode}.csv"));
-        let v = json(&[
+        let v = json::bench(&[
             "--scene",
             "dense",
             "--count",
@@ -325,7 +316,7 @@ fn flags_before_a_subcommand_are_refused_not_dropped() {
         assert!(out.stdout.is_empty(), "{args:?}");
     }
     // After the subcommand the same flag is honoured.
-    let v = json(&["--model", "exact", "--steps", "2", "--count", "20"]);
+    let v = json::bench(&["--model", "exact", "--steps", "2", "--count", "20"]);
     assert_eq!(v["model"], "exact");
     assert_eq!(v["n"], 20);
 }
@@ -362,7 +353,7 @@ fn clap_usage_errors_exit_2_and_help_exits_0() {
 
 #[test]
 fn dt_may_be_a_fraction() {
-    let v = json(&["--dt", "1/120", "--steps", "2", "--count", "20"]);
+    let v = json::bench(&["--dt", "1/120", "--steps", "2", "--count", "20"]);
     assert_eq!(v["dt"].as_f64(), Some(1.0 / 120.0));
 }
 
@@ -406,13 +397,8 @@ fn help_lists_the_allowed_values_and_ranges() {
 
 #[test]
 fn bench_help_names_exactly_the_fields_the_json_has() {
-    let out = ballpit()
-        .args(["bench", "--steps", "2", "--count", "20"])
-        .output()
-        .unwrap();
-    assert!(out.status.success());
     // Keep the printed order: a JSON object's keys in the line as written.
-    let line = String::from_utf8(out.stdout).unwrap();
+    let line = json::bench_line(&["--steps", "2", "--count", "20"]);
     let v: serde_json::Value = serde_json::from_str(&line).unwrap();
     let mut keys: Vec<(usize, &str)> = v
         .as_object()

@@ -2,6 +2,7 @@
 //! works: empty scene files, huge numbers, flags that do nothing, flags in
 //! the wrong place, the no-terminal message.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+use crate::common::json;
 use assert_cmd::Command;
 
 fn ballpit() -> Command {
@@ -64,12 +65,7 @@ fn zero_energy_from_tiny_masses_is_not_called_at_rest() {
         "tiny.csv",
         "x,y,z,vx,vy,vz,radius,mass\n0.5,0.5,0.5,0.1,0,0,0.1,5e-324\n",
     );
-    let out = ballpit()
-        .args(["bench", "--scene", path.to_str().unwrap(), "--steps", "1"])
-        .output()
-        .unwrap();
-    assert!(out.status.success());
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = json::bench(&["--scene", path.to_str().unwrap(), "--steps", "1"]);
     let w = v["warnings"].to_string();
     assert!(!w.contains("every sphere is at rest"), "{w}");
     assert!(w.contains("kinetic energy is 0"), "{w}");

@@ -2,14 +2,18 @@
 //! user gave (a flag, a file's key, a file's line), exit code 2, and no
 //! panic, allocation blow-up or quadratic placement.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+use crate::common::json;
 use assert_cmd::Command;
 use ballpit::scene::{SceneSpec, build_world, csv_io, toml_file};
 use std::fmt::Write as _;
 use std::time::{Duration, Instant};
 
+/// How long a run of `ballpit` here may take before it is killed and fails.
+const TIMEOUT: Duration = Duration::from_secs(30);
+
 fn ballpit() -> Command {
     let mut c = Command::cargo_bin("ballpit").unwrap();
-    c.timeout(Duration::from_secs(30));
+    c.timeout(TIMEOUT);
     c
 }
 
@@ -210,15 +214,11 @@ fn a_heap_of_overlapping_spheres_under_discrete_neither_fills_memory_nor_hangs()
         .unwrap();
     }
     std::fs::write(&path, text).unwrap();
-    let out = ballpit()
-        .args(["bench", "--model", "discrete", "--steps", "1", "--scene"])
-        .arg(&path)
-        .timeout(Duration::from_mins(2))
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(0), "{err}");
-    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let scene = path.to_str().unwrap();
+    let j = json::bench_within(
+        &["--model", "discrete", "--steps", "1", "--scene", scene],
+        Duration::from_mins(2),
+    );
     assert_eq!(j["capped_steps"], 1, "{j}");
     assert_eq!(j["budget_steps"], 1, "{j}");
     assert_eq!(j["escaped"], 0, "{j}");
@@ -428,13 +428,7 @@ mod fuzz {
 #[test]
 fn bench_json_says_which_promise_a_run_could_not_keep() {
     let warnings = |args: &[&str]| {
-        let out = ballpit().arg("bench").args(args).output().unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let v = json::bench_within(args, TIMEOUT);
         let w: Vec<String> = v["warnings"]
             .as_array()
             .unwrap()

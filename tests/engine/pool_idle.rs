@@ -2,23 +2,25 @@
 //! CPU. Shares of the process's own thread CPU (from /proc, in `ballpit
 //! bench`'s JSON), never wall times.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+use crate::common::json;
 
 /// CPU seconds by thread name of a `bench` run of 10 000 spheres (two lanes
 /// by the lane rule: 10 000 items over 4096 a lane) on a pool of 256.
 fn thread_cpu() -> (Vec<(String, f64)>, f64) {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_ballpit"))
-        .args([
-            "bench", "--count", "10000", "--radius", "0.0171", "--speed", "0.5",
-        ])
-        .args(["--steps", "60", "--threading", "pool", "--threads", "256"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let j = json::bench(&[
+        "--count",
+        "10000",
+        "--radius",
+        "0.0171",
+        "--speed",
+        "0.5",
+        "--steps",
+        "60",
+        "--threading",
+        "pool",
+        "--threads",
+        "256",
+    ]);
     let threads = j["thread_cpu"]
         .as_array()
         .unwrap()

@@ -98,13 +98,12 @@ fn a_fifo_that_never_closes_is_refused() {
         let fifo = d.join(format!("fifo.{ext}"));
         mkfifo(&fifo);
         // A writer that holds the FIFO open and sends a line, then nothing.
-        let mut writer = Command::new("sh")
-            .arg("-c")
-            .arg("exec 3>\"$1\"; echo x,y,z,vx,vy,vz,radius,mass >&3; sleep 30")
-            .arg("sh")
-            .arg(&fifo)
-            .spawn()
-            .unwrap();
+        let mut writer = sh_writing(
+            &fifo,
+            "exec 3>\"$1\"; echo x,y,z,vx,vy,vz,radius,mass >&3; sleep 30",
+        )
+        .spawn()
+        .unwrap();
         refused(&fifo, &format!("a FIFO that never closes, as {ext}"));
         let _ = writer.kill();
         let _ = writer.wait();
@@ -117,13 +116,12 @@ fn a_fifo_that_ends_is_read() {
     let d = dir("fifo_ends");
     let fifo = d.join("ends.csv");
     mkfifo(&fifo);
-    let mut writer = Command::new("sh")
-        .arg("-c")
-        .arg("printf 'x,y,z,vx,vy,vz,radius,mass\\n0.5,0.5,0.5,0,0,0,0.1,1\\n' > \"$1\"")
-        .arg("sh")
-        .arg(&fifo)
-        .spawn()
-        .unwrap();
+    let mut writer = sh_writing(
+        &fifo,
+        "printf 'x,y,z,vx,vy,vz,radius,mass\\n0.5,0.5,0.5,0,0,0,0.1,1\\n' > \"$1\"",
+    )
+    .spawn()
+    .unwrap();
     let (code, err, _) = bench(&fifo);
     assert_eq!(code, Some(0), "{err}");
     let _ = writer.wait();
@@ -135,11 +133,7 @@ fn an_endless_stream_of_valid_rows_stops_at_the_largest_scene() {
     let d = dir("rows");
     let fifo = d.join("rows.csv");
     mkfifo(&fifo);
-    let mut writer = Command::new("sh")
-        .arg("-c")
-        .arg("exec yes 0,0,0,0,0,0,0,0 > \"$1\"")
-        .arg("sh")
-        .arg(&fifo)
+    let mut writer = sh_writing(&fifo, "exec yes 0,0,0,0,0,0,0,0 > \"$1\"")
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
@@ -191,4 +185,11 @@ fn a_scene_on_stdin_is_read_within_the_same_bound() {
 fn mkfifo(path: &std::path::Path) {
     let made = Command::new("mkfifo").arg(path).status().unwrap();
     assert!(made.success(), "mkfifo {}", path.display());
+}
+
+/// `sh -c script` with `fifo` as `$1`: the FIFO's writer, to spawn.
+fn sh_writing(fifo: &Path, script: &str) -> Command {
+    let mut sh = Command::new("sh");
+    sh.arg("-c").arg(script).arg("sh").arg(fifo);
+    sh
 }

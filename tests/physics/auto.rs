@@ -2,6 +2,7 @@
 //! scenes, the same bits in every threading mode, and a live edit that
 //! crosses a boundary.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+use crate::common::json;
 use crate::common::random_scene::random_scene;
 use ballpit::engine::{Command, Engine, Settings, Threading};
 use ballpit::physics::auto::{Ask, Summary, Tolerance, choose};
@@ -397,27 +398,20 @@ fn the_tolerance_flag_is_checked_and_reported() {
             .unwrap()
             .contains("only steers --model auto")
     );
-    let json = |args: &[&str]| -> serde_json::Value {
-        let out = ballpit(args);
-        assert_eq!(out.status.code(), Some(0));
-        serde_json::from_slice(&out.stdout).unwrap()
-    };
-    let v = json(&[
-        "bench", "--scene", "dense", "--model", "auto", "--steps", "4",
-    ]);
+    let v = json::bench(&["--scene", "dense", "--model", "auto", "--steps", "4"]);
     assert_eq!(v["model"], "auto");
     assert_eq!(v["model_chosen"], "exact");
     assert!(
         v["model_reason"].as_str().unwrap().starts_with("dense"),
         "{v}"
     );
-    let v = json(&[
-        "bench", "--model", "auto", "--speed", "10000", "--dt", "1/15", "--steps", "2",
+    let v = json::bench(&[
+        "--model", "auto", "--speed", "10000", "--dt", "1/15", "--steps", "2",
     ]);
     assert_eq!(v["model_chosen"], "exact");
     let warned = v["warnings"].to_string();
     assert!(warned.contains("could not meet its tolerance"), "{warned}");
-    let v = json(&["bench", "--model", "swept", "--steps", "2"]);
+    let v = json::bench(&["--model", "swept", "--steps", "2"]);
     assert!(v["model_chosen"].is_null());
 }
 
