@@ -107,6 +107,7 @@ impl Frame {
         snap.steps = steps;
         snap.settings = self.settings;
         snap.choice = self.model.choice().cloned();
+        snap.report_threads();
         snap.switch_notice = switch_notice(self.chosen, snap.choice.as_ref());
         self.chosen = snap.choice.as_ref().map(|c| c.model);
         snap.notice.clone_from(&self.notice);

@@ -395,12 +395,11 @@ impl Engine {
         self.pool.as_ref().map(|p| p.parallel_seconds())
     }
 
-    /// The threads the current settings put physics work on, driver first
-    /// (see [`physics_threads`]); for `auto`, those of the model it runs.
+    /// The threads the latest finished frame's physics ran on, driver first
+    /// (its snapshot's `physics_threads`); for `auto`, those of the model
+    /// it ran.
     pub fn physics_threads(&self) -> Vec<String> {
-        let s = &self.settings;
-        let chosen = self.front.choice.as_ref().map(|c| c.model);
-        physics_threads(s.threading, s.threads, s.model.running(chosen))
+        self.front.physics_threads.clone()
     }
 
     fn check(&self) -> anyhow::Result<()> {
