@@ -57,9 +57,10 @@ pub struct Snapshot {
     /// Wall-clock seconds the physics of this frame took: its steps and the
     /// detection behind `max_overlap_rel`.
     pub physics_seconds: f64,
-    /// Steps run in this frame.
+    /// Steps run in this frame (none in a held one, `Engine::set_hold`).
     pub steps: u64,
-    /// The settings this frame ran with (what really ran).
+    /// The settings this frame ran with (what really ran; a held frame
+    /// keeps the tick it resumes with).
     pub settings: Settings,
     /// The threads this frame's physics ran on, driver first, as
     /// [`physics_threads`] names them for `settings` and the model that ran.

@@ -118,8 +118,7 @@ impl AppState {
             | Action::FewerThreads
             | Action::MoreThreads => self.apply_threads(action),
             Action::FlatOut | Action::TickDown | Action::TickUp | Action::Pause => {
-                self.apply_pace(action);
-                Vec::new()
+                self.apply_pace(action)
             }
             Action::HalveCount
             | Action::DoubleCount
@@ -215,8 +214,11 @@ impl AppState {
         out
     }
 
-    /// The pace keys: tick, flat out, pause (the loop sends the tick).
-    fn apply_pace(&mut self, action: Action) {
+    /// The pace keys: tick, flat out, pause. A new engine tick is sent
+    /// paused or not (a paused frame runs no step but keeps it); the pause
+    /// itself is the loop's to hold (`Engine::set_hold`).
+    fn apply_pace(&mut self, action: Action) -> Vec<Command> {
+        let before = self.engine_tick();
         match action {
             Action::FlatOut => {
                 self.flat_out = !self.flat_out;
@@ -254,6 +256,12 @@ impl AppState {
             }
             Action::Pause => self.paused = !self.paused,
             _ => {}
+        }
+        let after = self.engine_tick();
+        if after == before {
+            Vec::new()
+        } else {
+            vec![Command::SetTick(after)]
         }
     }
 

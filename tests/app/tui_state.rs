@@ -111,15 +111,15 @@ fn p_and_shift_p_change_the_pool_within_limits() {
 #[test]
 fn brackets_change_the_tick_and_zero_freezes() {
     let mut a = app();
-    // The tick goes to the engine at the next frame (0 while paused), so the
-    // key itself sends nothing.
-    assert!(key(&mut a, Press::Char(']')).is_empty());
+    // The tick goes to the engine like any setting, so the snapshot that
+    // answers it says the tick that ran.
+    assert_eq!(key(&mut a, Press::Char(']')), [Command::SetTick(2)]);
     assert_eq!(a.tick, 2);
     key(&mut a, Press::Char('['));
-    key(&mut a, Press::Char('['));
+    assert_eq!(key(&mut a, Press::Char('[')), [Command::SetTick(0)]);
     assert_eq!(a.tick, 0);
     assert!(!a.running());
-    key(&mut a, Press::Char('['));
+    assert!(key(&mut a, Press::Char('[')).is_empty());
     assert_eq!(a.tick, 0);
     assert!(a.notice.as_deref().unwrap().contains("frozen"));
     a.tick = MAX_TICK;
@@ -314,10 +314,44 @@ fn p_while_not_in_pool_mode_keeps_the_size_and_says_where_it_applies() {
 #[test]
 fn tick_keys_while_paused_say_the_tick_runs_on_resume() {
     let mut a = app();
-    key(&mut a, Press::Char(' '));
-    key(&mut a, Press::Char(']'));
+    // The pause is the loop's to hold: the engine keeps its tick.
+    assert!(key(&mut a, Press::Char(' ')).is_empty());
+    // Paused, the tick is sent all the same: the held frame that answers
+    // it runs no step but shows the tick the resume runs.
+    assert_eq!(key(&mut a, Press::Char(']')), [Command::SetTick(2)]);
     assert_eq!(a.tick, 2);
     assert!(a.notice.as_deref().unwrap().contains("resumed"));
+    assert!(key(&mut a, Press::Char(' ')).is_empty());
+}
+
+/// The pause as the loop holds it: a held frame applies the commands and
+/// answers them with a fresh snapshot, but runs no step, and its settings
+/// keep the tick for the resume (no tick 0 stands in for the pause).
+#[test]
+fn a_held_frame_answers_commands_without_a_step_and_keeps_the_tick() {
+    use ballpit::engine::Engine;
+    use ballpit::physics::{Sphere, World};
+    use glam::DVec3;
+    let spheres = vec![Sphere::new(DVec3::splat(0.5), DVec3::X, 0.05)];
+    let mut e = Engine::new(World::new(1.0, spheres), settings()).unwrap();
+    e.start_frame().unwrap();
+    let t = e.finish_frame().unwrap().time;
+    e.set_hold(true);
+    e.command(Command::SetTick(7));
+    e.command(Command::SetThreading(Threading::Worker));
+    e.start_frame().unwrap();
+    let snap = e.finish_frame().unwrap();
+    assert_eq!((snap.frame, snap.steps, snap.time), (2, 0, t));
+    assert_eq!(
+        (snap.settings.tick, snap.settings.threading),
+        (7, Threading::Worker)
+    );
+    assert_eq!(snap.physics_threads, ["physics"]);
+    e.set_hold(false);
+    e.start_frame().unwrap();
+    let snap = e.finish_frame().unwrap();
+    assert_eq!((snap.steps, snap.settings.tick), (7, 7));
+    assert!(snap.time > t);
 }
 
 #[test]
@@ -325,16 +359,16 @@ fn x_toggles_flat_out_and_goes_back_to_the_tick_before() {
     let mut a = app();
     a.tick = 0;
     assert!(!a.running());
-    key(&mut a, Press::Char('x'));
-    assert!(a.flat_out && a.running());
     // Flat out needs a tick above 0 for the engine; the tick is kept.
+    assert_eq!(key(&mut a, Press::Char('x')), [Command::SetTick(1)]);
+    assert!(a.flat_out && a.running());
     assert_eq!((a.tick, a.engine_tick()), (0, 1));
     assert!(a.notice.as_deref().unwrap().contains("flat out"));
     // The tick keys leave the tick alone while flat out, and say so.
     key(&mut a, Press::Char(']'));
     assert_eq!(a.tick, 0);
     assert!(a.notice.as_deref().unwrap().contains("x goes back"));
-    key(&mut a, Press::Char('x'));
+    assert_eq!(key(&mut a, Press::Char('x')), [Command::SetTick(0)]);
     assert!(!a.flat_out && !a.running());
 }
 
