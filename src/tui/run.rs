@@ -255,7 +255,7 @@ impl FrameLoop {
     fn handle(&mut self, msg: Msg) -> anyhow::Result<bool> {
         match msg {
             Msg::Action(action) => {
-                for cmd in self.state.apply(action) {
+                for cmd in self.state.apply(action, self.engine.snapshot()) {
                     self.engine.command(cmd);
                     self.pending = true;
                 }
@@ -398,7 +398,7 @@ impl FrameLoop {
         let st = &mut self.stats;
         st.fps = f64::from(w.frames) / secs;
         st.steps_per_second = w.steps as f64 / secs;
-        st.remember(&self.state);
+        st.remember(&self.state, &self.engine.snapshot().settings);
         st.collisions_per_second = total.saturating_sub(w.collisions_at_start) as f64 / secs;
         if w.frames > 0 {
             st.render_seconds = w.render_seconds / f64::from(w.frames);

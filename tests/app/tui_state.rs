@@ -1,10 +1,11 @@
 //! Every key's effect on the app state, without a terminal.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
-use ballpit::engine::{Command, Settings, Threading};
+use ballpit::engine::{Command, Settings, Snapshot, Threading};
 use ballpit::physics::ModelKind;
 use ballpit::tui::canvas::{DrawStyle, LIGHT_STEPS};
 use ballpit::tui::keys::{Action, Press, lookup};
 use ballpit::tui::state::{AppState, CAMERA_STEP, MAX_PITCH, MAX_TICK, MIN_RADIUS, RADIUS_STEP};
+use std::sync::LazyLock;
 
 fn settings() -> Settings {
     Settings {
@@ -20,9 +21,31 @@ fn app() -> AppState {
     AppState::new(&settings(), 1000, 0.02, 30.0)
 }
 
+/// What ran before the keys: the engine's first snapshot of a small scene
+/// at `settings()`.
+fn ran() -> &'static Snapshot {
+    static RAN: LazyLock<Snapshot> = LazyLock::new(|| ran_with(settings()));
+    &RAN
+}
+
+fn ran_with(s: Settings) -> Snapshot {
+    use ballpit::physics::{Sphere, World};
+    use glam::DVec3;
+    let spheres = vec![Sphere::new(DVec3::splat(0.5), DVec3::X, 0.05)];
+    ballpit::engine::Engine::new(World::new(1.0, spheres), s)
+        .unwrap()
+        .snapshot()
+        .clone()
+}
+
 fn key(app: &mut AppState, press: Press) -> Vec<Command> {
+    key_after(app, press, ran())
+}
+
+/// A key pressed with `ran` the latest snapshot.
+fn key_after(app: &mut AppState, press: Press, ran: &Snapshot) -> Vec<Command> {
     let a = lookup(press).expect("a mapped key");
-    app.apply(a)
+    app.apply(a, ran)
 }
 
 #[test]
@@ -34,7 +57,7 @@ fn q_esc_and_ctrl_c_quit() {
     }
     let mut a = app();
     let ctrl_c = lookup(Press::Ctrl('c')).unwrap();
-    a.apply(ctrl_c);
+    a.apply(ctrl_c, ran());
     assert!(a.quit);
 }
 
@@ -227,10 +250,10 @@ fn f_and_shift_f_step_the_frame_rate() {
     key(&mut a, Press::Char('f'));
     assert_eq!(a.fps, 20.0);
     let mut b = AppState::new(&settings(), 10, 0.1, 24.0);
-    b.apply(Action::FasterFps);
+    b.apply(Action::FasterFps, ran());
     assert_eq!(b.fps, 30.0);
     for _ in 0..10 {
-        b.apply(Action::SlowerFps);
+        b.apply(Action::SlowerFps, ran());
     }
     assert_eq!(b.fps, 5.0);
 }
@@ -305,10 +328,20 @@ fn p_while_not_in_pool_mode_keeps_the_size_and_says_where_it_applies() {
     a.threading = Threading::Pool;
     assert_eq!(key(&mut a, Press::Char('p')), [Command::SetThreads(4)]);
     assert!(a.notice.is_none());
-    // In pool mode with exact, the size has no effect either.
+    // In pool mode with exact, the size has no effect either: the engine
+    // said exact ran on one lane.
+    let exact = ran_with(Settings {
+        model: ModelKind::Exact,
+        ..settings()
+    });
+    assert!(exact.one_lane);
     a.model = ModelKind::Exact;
-    key(&mut a, Press::Char('P'));
+    key_after(&mut a, Press::Char('P'), &exact);
     assert!(a.notice.as_deref().unwrap().contains("exact"));
+    // Another model asked since: the snapshot cannot say, so no claim.
+    a.model = ModelKind::Swept;
+    key_after(&mut a, Press::Char('P'), &exact);
+    assert!(a.notice.is_none());
 }
 
 #[test]
@@ -482,9 +515,11 @@ fn sync_shows_auto_s_switch_after_the_key_s_answer_and_takes_what_it_runs() {
     // No key of ours: the switch alone.
     a.sync(&snap, false);
     assert_eq!(a.notice.as_deref(), Some("auto: swept → exact (dense)"));
-    assert_eq!(a.running_model(), ModelKind::Exact);
-    // `exact` runs, so the pool size does nothing to it: the key says so.
-    key(&mut a, Press::Char('P'));
+    // `exact` ran, on one lane as the engine says, so the pool size does
+    // nothing to it: the key says so.
+    snap.one_lane = true;
+    assert_eq!(snap.model_ran(), ModelKind::Exact);
+    key_after(&mut a, Press::Char('P'), &snap);
     assert!(
         a.notice
             .as_deref()
@@ -503,7 +538,8 @@ fn sync_shows_auto_s_switch_after_the_key_s_answer_and_takes_what_it_runs() {
     snap.switch_notice = None;
     a.sync(&snap, false);
     assert_eq!(a.notice.as_deref(), Some(n.as_str()));
-    // Another model: what runs is the model itself.
+    // Another model asked: auto's choice no longer speaks for it.
     key(&mut a, Press::Char('m'));
-    assert_eq!(a.running_model(), ModelKind::Discrete);
+    key_after(&mut a, Press::Char('P'), &snap);
+    assert!(!a.notice.as_deref().unwrap_or("").contains("one thread"));
 }
