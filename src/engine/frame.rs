@@ -26,6 +26,8 @@ pub(crate) struct Frame {
     /// Flat out: step until this much time has passed (at least one step)
     /// instead of `tick` steps.
     pub budget: Option<Duration>,
+    /// The screen's pause: no step, whatever the tick.
+    pub hold: bool,
     /// Steps done so far in the frame under way, for the screen to read
     /// while a long frame runs.
     pub progress: Arc<AtomicU64>,
@@ -56,6 +58,7 @@ impl Frame {
             snap,
             views,
             budget: None,
+            hold: false,
             progress: Arc::default(),
             scratch: OverlapScratch::default(),
             chosen: None,
@@ -107,18 +110,24 @@ impl Frame {
         snap.steps = steps;
         snap.settings = self.settings;
         snap.choice = self.model.choice().cloned();
+        snap.report_threads();
         snap.switch_notice = switch_notice(self.chosen, snap.choice.as_ref());
         self.chosen = snap.choice.as_ref().map(|c| c.model);
         snap.notice.clone_from(&self.notice);
     }
 
     /// Run the frame's steps in whole chunks, each sized from the mean step
-    /// so far: `tick` steps, or as many as `budget` allows (at least one).
+    /// so far: `tick` steps, or as many as `budget` allows (at least one);
+    /// none while held.
     /// Chunks let a long frame report its progress and flat out stop near
     /// its budget; the models give the same bits however the steps are cut.
     fn step(&mut self, t0: Instant) -> u64 {
         let dt = self.settings.dt;
-        let tick = u64::from(self.settings.tick);
+        let tick = if self.hold {
+            0
+        } else {
+            u64::from(self.settings.tick)
+        };
         let budget = self.budget.filter(|_| tick > 0);
         // `exact` and `auto` give other bits when their steps are cut
         // differently, so they step one at a time flat out (a state then

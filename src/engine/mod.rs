@@ -166,6 +166,8 @@ pub struct Engine {
     rng: Xoshiro256PlusPlus,
     /// Flat out: each frame steps for this long (see [`Engine::set_budget`]).
     budget: Option<Duration>,
+    /// Frames run no step (see [`Engine::set_hold`]).
+    hold: bool,
     /// The frame's step counter, and when the frame in flight started.
     progress: Arc<AtomicU64>,
     started: Instant,
@@ -245,6 +247,7 @@ impl Engine {
             failed: None,
             rng: Xoshiro256PlusPlus::seed_from_u64(EDIT_SEED),
             budget: None,
+            hold: false,
             progress,
             started: Instant::now(),
             running: false,
@@ -263,6 +266,14 @@ impl Engine {
     /// sets it from the frame period, so the screen keeps its rate.
     pub fn set_budget(&mut self, budget: Option<Duration>) {
         self.budget = budget;
+    }
+
+    /// The screen's pause: from the next frame on, while `hold`, a frame
+    /// applies the queued commands and fills its snapshot but runs no step
+    /// (its `steps` are 0), so a command is answered with a fresh snapshot
+    /// whose settings keep the tick for the resume.
+    pub fn set_hold(&mut self, hold: bool) {
+        self.hold = hold;
     }
 
     /// Queue a change for the next frame boundary.
@@ -288,6 +299,7 @@ impl Engine {
             return Err(e);
         }
         frame.budget = self.budget;
+        frame.hold = self.hold;
         self.running = true;
         if self.settings.threading == Threading::Off {
             let frame = worker::run_caught(frame).map_err(|e| self.fail(e))?;
@@ -395,12 +407,11 @@ impl Engine {
         self.pool.as_ref().map(|p| p.parallel_seconds())
     }
 
-    /// The threads the current settings put physics work on, driver first
-    /// (see [`physics_threads`]); for `auto`, those of the model it runs.
+    /// The threads the latest finished frame's physics ran on, driver first
+    /// (its snapshot's `physics_threads`); for `auto`, those of the model
+    /// it ran.
     pub fn physics_threads(&self) -> Vec<String> {
-        let s = &self.settings;
-        let chosen = self.front.choice.as_ref().map(|c| c.model);
-        physics_threads(s.threading, s.threads, s.model.running(chosen))
+        self.front.physics_threads.clone()
     }
 
     fn check(&self) -> anyhow::Result<()> {

@@ -1,13 +1,13 @@
 //! What the screen reads of a finished frame. Two of them exist: the front
 //! one the renderer reads while the physics fills the back one.
-use super::Settings;
+use super::{Settings, physics_threads};
 use crate::physics::auto::Choice;
 use crate::physics::broad::Grid;
 use crate::physics::discrete::pair_budget;
 use crate::physics::exec::{Busy, for_each_block_of, for_each_chunk};
 use crate::physics::sphere::overlap_rel;
 use crate::physics::world::escapes;
-use crate::physics::{Counters, Exec, World};
+use crate::physics::{Counters, Exec, ModelKind, World};
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 
 /// Spheres per parallel block when copying them out.
@@ -57,10 +57,18 @@ pub struct Snapshot {
     /// Wall-clock seconds the physics of this frame took: its steps and the
     /// detection behind `max_overlap_rel`.
     pub physics_seconds: f64,
-    /// Steps run in this frame.
+    /// Steps run in this frame (none in a held one, `Engine::set_hold`).
     pub steps: u64,
-    /// The settings this frame ran with (what really ran).
+    /// The settings this frame ran with (what really ran; a held frame
+    /// keeps the tick it resumes with).
     pub settings: Settings,
+    /// The threads this frame's physics ran on, driver first, as
+    /// [`physics_threads`] names them for `settings` and the model that ran.
+    pub physics_threads: Vec<String>,
+    /// The model that ran keeps to one lane of those threads (`exact`'s
+    /// event loop): in `pool` the frame is on one pool thread (rayon picks
+    /// which), so the pool's size does nothing to it.
+    pub one_lane: bool,
     /// A limit the last count or radius command hit, e.g. "radius limit:
     /// spheres touch at r = 0.0310"; kept until the next such command.
     pub notice: Option<String>,
@@ -96,9 +104,12 @@ impl Snapshot {
             physics_seconds: 0.0,
             steps: 0,
             settings,
+            physics_threads: Vec::new(),
+            one_lane: false,
             notice: None,
             pool_busy: None,
         };
+        s.report_threads();
         let serial = crate::physics::Serial;
         let overlap = OverlapScratch::default().measure(world, &serial);
         s.fill_world(world, 1, overlap, &serial, views);
@@ -170,6 +181,22 @@ impl Snapshot {
         self.overlap_partial = overlap.partial;
         self.escaped = escaped.into_inner();
         self.counters = world.counters;
+    }
+
+    /// The model that ran: for `auto`, the one it chose.
+    pub fn model_ran(&self) -> ModelKind {
+        self.settings
+            .model
+            .running(self.choice.as_ref().map(|c| c.model))
+    }
+
+    /// Say where the physics ran, from `settings` and `choice` (set
+    /// before): the engine's one answer to it, which the screen shows.
+    pub(crate) fn report_threads(&mut self) {
+        let s = self.settings;
+        let ran = self.model_ran();
+        self.one_lane = ran.runs_on_one_lane();
+        self.physics_threads = physics_threads(s.threading, s.threads, ran);
     }
 
     /// `|E - E_reset| / E_reset` (0 for a world at rest).

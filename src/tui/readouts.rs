@@ -3,7 +3,7 @@
 use super::state::{AppState, representative_radius};
 use super::theme::Palette;
 use super::wrap::wrap;
-use crate::engine::{Snapshot, Threading, physics_threads};
+use crate::engine::{Settings, Snapshot, Threading};
 use crate::physics::ModelKind;
 use crate::physics::auto::Choice;
 use ratatui::buffer::Buffer;
@@ -35,7 +35,7 @@ pub struct Stats {
     pub link_slow: bool,
     /// A threaded frame still computing: its steps so far and its age.
     pub under_way: Option<(u64, Duration)>,
-    /// Flat out: steps/s measured per mode (`AppState::mode_label`) on the
+    /// Flat out: steps/s measured per mode ([`mode_label`]) on the
     /// scene `flat_scene`, the latest whole second of each.
     pub flat: Vec<(String, f64)>,
     pub flat_scene: u64,
@@ -58,15 +58,16 @@ impl Stats {
         Duration::from_secs_f64(share.clamp(0.1 * period, 0.9 * period))
     }
 
-    /// After a second's figures: keep flat out's steps/s for this mode, if
-    /// the whole second ran flat out in this mode on this scene; a new
-    /// scene starts the comparison again.
-    pub fn remember(&mut self, state: &AppState) {
+    /// After a second's figures: keep flat out's steps/s for the mode that
+    /// ran (`ran`, the latest snapshot's settings), if the whole second ran
+    /// flat out in this mode on this scene; a new scene starts the
+    /// comparison again.
+    pub fn remember(&mut self, state: &AppState, ran: &Settings) {
         if self.flat_scene != state.scene {
             self.flat.clear();
             self.flat_scene = state.scene;
         }
-        let now = (state.flat_out && state.running()).then(|| (state.mode_label(), state.scene));
+        let now = (state.flat_out && state.running()).then(|| (mode_label(ran), state.scene));
         if let Some(n) = &now
             && self.flat_last.as_ref() == Some(n)
             && self.steps_per_second > 0.0
@@ -105,20 +106,32 @@ pub struct Readouts<'a> {
     pub palette: Palette,
 }
 
+/// The mode as flat out's comparison names it (a pool with its size).
+pub fn mode_label(settings: &Settings) -> String {
+    match settings.threading {
+        Threading::Pool => format!("pool {}", settings.threads),
+        t => t.name().to_string(),
+    }
+}
+
+/// The rows that say what ran (threading, tick, model) read the snapshot's
+/// settings and the threads the engine says the physics ran on; the state
+/// gives only what is the screen's own: the pause, flat out, the frame
+/// rate, the mode `t` goes back to.
 impl Readouts<'_> {
     fn threading(&self) -> String {
-        let s = self.state;
-        // `auto` runs on the lanes of the model it chose.
-        let m = s.running_model();
-        let threads = physics_threads(s.threading, s.threads, m).len();
-        match s.threading {
-            Threading::Off => format!("off      on main; t -> {}", s.last_threaded),
+        let snap = self.snap;
+        // `auto` ran on the lanes of the model it chose.
+        let m = snap.model_ran();
+        let threads = snap.physics_threads.len();
+        match snap.settings.threading {
+            Threading::Off => format!("off      on main; t -> {}", self.state.last_threaded),
             // A model on one lane does not split: say where it runs (a
             // pool hosts the whole frame on one of its threads).
-            Threading::Pool if m.runs_on_one_lane() => {
+            Threading::Pool if snap.one_lane => {
                 format!("{:<8} {} on 1 pool thread", Threading::Pool.name(), m)
             }
-            Threading::Split if m.runs_on_one_lane() => {
+            Threading::Split if snap.one_lane => {
                 format!("{:<8} {} runs on physics", Threading::Split.name(), m)
             }
             t => format!(
@@ -198,7 +211,7 @@ impl Readouts<'_> {
                 now
             };
         }
-        match st.speed_up(&self.state.mode_label()) {
+        match st.speed_up(&mode_label(&self.snap.settings)) {
             Some(x) if compact => format!("{now} {x:.2}x"),
             Some(x) => format!("{now} flat out, {x:.2}x off"),
             None if compact => now,
@@ -259,20 +272,18 @@ impl Readouts<'_> {
                 Span::raw(value),
             ])
         };
-        let mut tick = format!(
-            "{:<8} step{}/frame",
-            s.tick,
-            if s.tick == 1 { "" } else { "s" }
-        );
+        // The tick that ran; flat out is the screen's (it sets the steps
+        // each frame, and keeps the tick x goes back to).
+        let ran = snap.settings.tick;
+        let mut tick = format!("{ran:<8} step{}/frame", if ran == 1 { "" } else { "s" });
         if s.flat_out {
             tick = format!("{:<8} flat out (x: tick {})", "max", s.tick);
-        } else if s.tick == 0 {
+        } else if ran == 0 {
             tick.push_str("  frozen");
         } else {
             tick = format!(
-                "{} step{}/frame  {}",
-                s.tick,
-                if s.tick == 1 { "" } else { "s" },
+                "{ran} step{}/frame  {}",
+                if ran == 1 { "" } else { "s" },
                 self.sim_speed()
             );
         }
@@ -283,7 +294,7 @@ impl Readouts<'_> {
             row("radius", self.radius(false)),
             row(
                 "model",
-                model_row(s.model, snap.parts, snap.choice.as_ref()),
+                model_row(snap.settings.model, snap.parts, snap.choice.as_ref()),
             ),
             row("style", s.style.name().to_string()),
             row("colour", self.colour()),
@@ -343,9 +354,10 @@ impl Readouts<'_> {
                 Span::raw(bv),
             ])
         };
+        let asked = snap.settings.model.name();
         let name = match &snap.choice {
-            Some(c) => format!("{}→{}", s.model.name(), c.model),
-            None => s.model.name().to_string(),
+            Some(c) => format!("{asked}→{}", c.model),
+            None => asked.to_string(),
         };
         let model = if snap.parts > 1 {
             format!("{name} cut {}", snap.parts)
@@ -364,7 +376,8 @@ impl Readouts<'_> {
                 if s.flat_out {
                     "max".into()
                 } else {
-                    format!("{} step{}", s.tick, if s.tick == 1 { "" } else { "s" })
+                    let ran = snap.settings.tick;
+                    format!("{ran} step{}", if ran == 1 { "" } else { "s" })
                 },
                 "count",
                 snap.count.to_string(),

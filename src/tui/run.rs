@@ -73,10 +73,15 @@ pub fn run_with(
         opts.fps,
     );
     state.flat_out = opts.flat_out;
-    let engine = match rebuild {
+    let mut engine = match rebuild {
         Some(r) => Engine::with_rebuild(world, settings, r)?,
         None => Engine::new(world, settings)?,
     };
+    // The keys send the tick when it changes; flat out from the command
+    // line needs one above 0 from the first frame.
+    if state.engine_tick() != settings.tick {
+        engine.command(Command::SetTick(state.engine_tick()));
+    }
 
     let (tx, rx) = crossbeam_channel::unbounded();
     // A frame slower than the frame period is collected when it is done,
@@ -116,8 +121,6 @@ struct FrameLoop {
     stats: Stats,
     sampler: Sampler,
     report: CpuReport,
-    /// The tick the engine was last told (0 while paused).
-    sent_tick: u32,
     /// Commands sent that no frame has applied yet.
     pending: bool,
     /// A frame was started and not finished; whether it applied commands.
@@ -149,7 +152,6 @@ struct Window {
 
 impl FrameLoop {
     fn new(engine: Engine, state: AppState, presenter: Presenter, detected: Palette) -> FrameLoop {
-        let sent_tick = engine.settings().tick;
         let collisions = collisions(engine.snapshot());
         let mut sampler = Sampler::new();
         let report = sampler.sample().clone();
@@ -164,7 +166,6 @@ impl FrameLoop {
             },
             sampler,
             report,
-            sent_tick,
             pending: false,
             in_flight: None,
             late: false,
@@ -254,7 +255,7 @@ impl FrameLoop {
     fn handle(&mut self, msg: Msg) -> anyhow::Result<bool> {
         match msg {
             Msg::Action(action) => {
-                for cmd in self.state.apply(action) {
+                for cmd in self.state.apply(action, self.engine.snapshot()) {
                     self.engine.command(cmd);
                     self.pending = true;
                 }
@@ -313,15 +314,9 @@ impl FrameLoop {
             self.dirty = true;
         }
         if self.state.running() || self.pending {
-            let tick = if self.state.running() {
-                self.state.engine_tick()
-            } else {
-                0
-            };
-            if tick != self.sent_tick {
-                self.engine.command(Command::SetTick(tick));
-                self.sent_tick = tick;
-            }
+            // Paused, a frame only answers the keys' commands: no step, the
+            // tick kept for the resume.
+            self.engine.set_hold(self.state.paused);
             if self.pending {
                 // The key's answer first: applying it may take long (N).
                 self.present()?;
@@ -403,7 +398,7 @@ impl FrameLoop {
         let st = &mut self.stats;
         st.fps = f64::from(w.frames) / secs;
         st.steps_per_second = w.steps as f64 / secs;
-        st.remember(&self.state);
+        st.remember(&self.state, &self.engine.snapshot().settings);
         st.collisions_per_second = total.saturating_sub(w.collisions_at_start) as f64 / secs;
         if w.frames > 0 {
             st.render_seconds = w.render_seconds / f64::from(w.frames);

@@ -39,8 +39,6 @@ pub struct AppState {
     /// `auto`'s tolerance (the `<` / `>` keys), kept while another model
     /// runs so that `m` comes back to it.
     pub tolerance: Tolerance,
-    /// What `auto` ran in the last frame (`None` for the other models).
-    pub chosen: Option<ModelKind>,
     pub count: usize,
     pub radius: f64,
     pub camera: Camera,
@@ -76,7 +74,6 @@ impl AppState {
             paused: false,
             model: settings.model,
             tolerance: settings.model.tolerance().unwrap_or_default(),
-            chosen: None,
             count,
             radius,
             camera: Camera::default(),
@@ -107,19 +104,20 @@ impl AppState {
         }
     }
 
-    /// Do one key; returns what the engine must be told.
+    /// Do one key; returns what the engine must be told. `ran` is the
+    /// latest snapshot: what ran, for the notices that say what a key will
+    /// (not) change.
     #[allow(clippy::too_many_lines)] // one arm a key, as the key table lists them
-    pub fn apply(&mut self, action: Action) -> Vec<Command> {
+    pub fn apply(&mut self, action: Action, ran: &Snapshot) -> Vec<Command> {
         self.notice = None;
         self.under_way = false;
         let out = match action {
             Action::ToggleThreading
             | Action::CycleThreadedMode
             | Action::FewerThreads
-            | Action::MoreThreads => self.apply_threads(action),
+            | Action::MoreThreads => self.apply_threads(action, ran),
             Action::FlatOut | Action::TickDown | Action::TickUp | Action::Pause => {
-                self.apply_pace(action);
-                Vec::new()
+                self.apply_pace(action)
             }
             Action::HalveCount
             | Action::DoubleCount
@@ -157,7 +155,7 @@ impl AppState {
     }
 
     /// The threading keys: mode and pool size.
-    fn apply_threads(&mut self, action: Action) -> Vec<Command> {
+    fn apply_threads(&mut self, action: Action, ran: &Snapshot) -> Vec<Command> {
         let mut out = Vec::new();
         match action {
             Action::ToggleThreading => {
@@ -202,10 +200,12 @@ impl AppState {
                             "pool threads {want}: kept for pool mode (now {})",
                             self.threading
                         ));
-                    } else if self.running_model().runs_on_one_lane() {
+                    } else if ran.one_lane && ran.settings.model == self.model {
+                        // The engine said the model kept to one lane, and
+                        // no other model is asked since.
                         self.notice = Some(format!(
                             "pool threads {want}: {} runs on one thread",
-                            self.running_model()
+                            ran.model_ran()
                         ));
                     }
                 }
@@ -215,8 +215,11 @@ impl AppState {
         out
     }
 
-    /// The pace keys: tick, flat out, pause (the loop sends the tick).
-    fn apply_pace(&mut self, action: Action) {
+    /// The pace keys: tick, flat out, pause. A new engine tick is sent
+    /// paused or not (a paused frame runs no step but keeps it); the pause
+    /// itself is the loop's to hold (`Engine::set_hold`).
+    fn apply_pace(&mut self, action: Action) -> Vec<Command> {
+        let before = self.engine_tick();
         match action {
             Action::FlatOut => {
                 self.flat_out = !self.flat_out;
@@ -254,6 +257,12 @@ impl AppState {
             }
             Action::Pause => self.paused = !self.paused,
             _ => {}
+        }
+        let after = self.engine_tick();
+        if after == before {
+            Vec::new()
+        } else {
+            vec![Command::SetTick(after)]
         }
     }
 
@@ -354,19 +363,6 @@ impl AppState {
         }
     }
 
-    /// The mode as flat out's comparison names it (a pool with its size).
-    pub fn mode_label(&self) -> String {
-        match self.threading {
-            Threading::Pool => format!("pool {}", self.threads),
-            t => t.name().to_string(),
-        }
-    }
-
-    /// The model that really runs: `auto`'s choice of the last frame.
-    pub fn running_model(&self) -> ModelKind {
-        self.model.running(self.chosen)
-    }
-
     /// `<` / `>`: the tolerance one step of the ladder tighter / looser;
     /// `auto` is asked again with it, the other models keep it for `m`.
     fn step_tolerance(&mut self, action: Action) -> Option<Command> {
@@ -402,7 +398,6 @@ impl AppState {
     /// commands, so its notice (or the lack of one) answers them.
     pub fn sync(&mut self, snap: &Snapshot, applied: bool) {
         self.count = snap.count;
-        self.chosen = snap.choice.as_ref().map(|c| c.model);
         if let Some(r) = representative_radius(snap) {
             self.radius = r;
         }

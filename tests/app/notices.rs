@@ -91,19 +91,25 @@ fn states() -> Vec<AppState> {
 
 /// The notices the keys give, each with a state that shows it.
 fn key_notices(into: &mut BTreeMap<String, (AppState, Snapshot)>) {
-    let snap = snapshot();
+    // What ran before the key: the state's own mode and model, so the
+    // notices that read the snapshot (`exact` on one lane) come up too.
+    let mut ran = std::collections::HashMap::new();
     let actions: Vec<_> = TABLE
         .iter()
         .flat_map(|b| b.presses.iter().map(|(_, a)| *a))
         .collect();
     for st in states() {
+        let snap: &Snapshot = ran.entry((st.threading, st.model)).or_insert_with(|| {
+            let e = Engine::new(world(), settings(st.model, st.threading)).unwrap();
+            e.snapshot().clone()
+        });
         // The pause's own line, when no key has spoken.
-        if let Some(n) = readouts(&st, &snap).notice() {
+        if let Some(n) = readouts(&st, snap).notice() {
             into.entry(n).or_insert_with(|| (st.clone(), snap.clone()));
         }
         for a in &actions {
             let mut after = st.clone();
-            after.apply(*a);
+            after.apply(*a, snap);
             if let Some(n) = after.notice.clone() {
                 into.entry(n).or_insert_with(|| (after, snap.clone()));
             }

@@ -207,9 +207,13 @@ fn s_sorts_the_rows_by_cpu_and_back() {
         threads: 2,
     };
     let mut st = AppState::new(&settings, 4, 0.1, 30.0);
+    let ran = ballpit::engine::Engine::new(ballpit::physics::World::new(1.0, Vec::new()), settings)
+        .unwrap()
+        .snapshot()
+        .clone();
     assert!(!st.threads_by_cpu);
-    assert!(st.apply(Action::SortThreads).is_empty());
+    assert!(st.apply(Action::SortThreads, &ran).is_empty());
     assert!(st.threads_by_cpu);
-    st.apply(Action::SortThreads);
+    st.apply(Action::SortThreads, &ran);
     assert!(!st.threads_by_cpu);
 }

@@ -422,3 +422,35 @@ fn empty_and_one_cell_terminals_and_term_dumb_neither_panic_nor_spin() {
         assert!(st.success(), "{size:?} {term}: {st:?}");
     }
 }
+
+/// The readouts show what ran, so a key must still bring a snapshot while
+/// paused or frozen: the tick and the mode change on screen at once, the
+/// tick is kept through the pause, and tick 0 shows as frozen.
+#[test]
+fn keys_while_paused_or_frozen_show_in_the_readouts() {
+    let mut app = start(&["--count", "200", "--tick", "3"], None);
+    app.wait_for("tick 3", 10.0, |s| tick(s) == Some(3));
+    app.send(" ");
+    app.wait_for("paused", 3.0, |s| {
+        readout(s, "fps").is_some_and(|v| v.starts_with("paused"))
+    });
+    app.send("]");
+    app.wait_for("tick 4 while paused", 3.0, |s| tick(s) == Some(4));
+    app.send("t");
+    let s = app.wait_for("worker while paused", 3.0, |s| {
+        readout(s, "threading").is_some_and(|v| v.starts_with("worker"))
+    });
+    assert_eq!(tick(&s), Some(4), "the pause keeps the tick\n{s}");
+    app.send(" ");
+    app.wait_for("running again", 3.0, |s| {
+        readout(s, "fps").is_some_and(|v| !v.starts_with("paused"))
+    });
+    app.send("[[[[");
+    let s = app.wait_for("tick 0", 3.0, |s| tick(s) == Some(0));
+    assert!(
+        readout(&s, "tick").is_some_and(|v| v.contains("frozen")),
+        "{s}"
+    );
+    app.send("q");
+    assert!(app.wait_exit(3.0).expect("q ends the app").success());
+}

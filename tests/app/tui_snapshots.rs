@@ -28,13 +28,29 @@ fn settings() -> Settings {
 }
 
 fn snapshot() -> Snapshot {
+    snapshot_at(settings())
+}
+
+/// The snapshot of a frame that ran with the settings `st` asked for: the
+/// screen in steady state, once the engine has applied the keys.
+fn ran(st: &AppState) -> Snapshot {
+    snapshot_at(Settings {
+        model: st.model,
+        tick: st.engine_tick(),
+        threading: st.threading,
+        threads: st.threads,
+        ..settings()
+    })
+}
+
+fn snapshot_at(s: Settings) -> Snapshot {
     let spheres = vec![
         Sphere::new(DVec3::new(0.5, 0.5, 0.5), DVec3::new(0.1, 0.0, 0.0), 0.12),
         Sphere::new(DVec3::new(0.2, 0.3, 0.7), DVec3::new(0.0, 0.9, 0.0), 0.08),
         Sphere::new(DVec3::new(0.8, 0.2, 0.2), DVec3::new(0.0, 0.0, 0.4), 0.1),
         Sphere::new(DVec3::new(0.75, 0.8, 0.8), DVec3::new(0.3, 0.3, 0.0), 0.15),
     ];
-    let engine = Engine::new(World::new(1.0, spheres), settings()).unwrap();
+    let engine = Engine::new(World::new(1.0, spheres), s).unwrap();
     let mut snap = engine.snapshot().clone();
     snap.physics_seconds = 0.00123;
     snap.energy = snap.energy_reset * (1.0 + 2.5e-13);
@@ -197,7 +213,7 @@ fn readouts_panel_says_exact_runs_on_one_thread_in_pool_mode() {
     let mut st = state();
     st.threading = Threading::Pool;
     st.model = ballpit::physics::ModelKind::Exact;
-    let t = readouts(&st, &snapshot(), Palette::C16);
+    let t = readouts(&st, &ran(&st), Palette::C16);
     let text = format!("{:?}", t.backend().buffer());
     assert!(text.contains("pool     exact on 1 pool thread"), "{text}");
 }
@@ -208,7 +224,7 @@ fn readouts_panel_paused_in_pool_mode() {
     st.threading = Threading::Pool;
     st.threads = 3;
     st.paused = true;
-    let t = readouts(&st, &snapshot(), Palette::Mono);
+    let t = readouts(&st, &ran(&st), Palette::Mono);
     insta::assert_snapshot!(t.backend());
     // Without colour, the pause cue is reverse video.
     let buf = t.backend().buffer();
@@ -400,7 +416,7 @@ fn screen_with(
     r: &CpuReport,
     stats: &Stats,
 ) -> Terminal<TestBackend> {
-    let snap = snapshot();
+    let snap = ran(st);
     let view = View {
         state: st,
         snap: &snap,
@@ -588,12 +604,97 @@ fn chart_view_has_a_line_per_thread_and_groups_many() {
     assert!(text.contains("pool-* max of 64"), "{text}");
 }
 
+/// The rows that say what ran read the snapshot, never the state: a state
+/// asking for one thing beside a snapshot that ran another shows the
+/// snapshot's (as between a key and the frame that applies it).
+#[test]
+fn readouts_show_the_mode_threads_model_and_tick_that_ran_not_those_asked() {
+    let compact = |st: &AppState, snap: &Snapshot| {
+        let stats = stats();
+        let t = render(44, ballpit::tui::readouts::COMPACT_HEIGHT, |f| {
+            f.render_widget(
+                Readouts {
+                    state: st,
+                    snap,
+                    stats: &stats,
+                    palette: Palette::C16,
+                },
+                f.area(),
+            );
+        });
+        rows(&t).join("\n")
+    };
+    // Asked: pool of 3, exact, tick 5. Ran: worker, swept, tick 2.
+    let mut st = mode_state(Threading::Pool, 3);
+    st.model = ModelKind::Exact;
+    st.tick = 5;
+    let worker = snapshot_at(Settings {
+        threading: Threading::Worker,
+        tick: 2,
+        ..settings()
+    });
+    let text = rows(&readouts(&st, &worker, Palette::C16)).join("\n");
+    assert!(
+        text.contains("threading  worker   1 physics thread "),
+        "{text}"
+    );
+    assert!(text.contains("tick       2 steps/frame"), "{text}");
+    assert!(text.contains("model      swept"), "{text}");
+    assert!(!text.contains("pool") && !text.contains("exact"), "{text}");
+    let small = compact(&st, &worker);
+    assert!(small.contains("worker   1 physics thread "), "{small}");
+    assert!(small.contains("tick    2 steps"), "{small}");
+    assert!(small.contains("model   swept"), "{small}");
+    // Asked: off. Ran: a pool of 3, whose threads the engine names.
+    let st = state();
+    let pool = snapshot_at(Settings {
+        threading: Threading::Pool,
+        threads: 3,
+        ..settings()
+    });
+    assert_eq!(pool.physics_threads, ["pool-0", "pool-1", "pool-2"]);
+    let text = rows(&readouts(&st, &pool, Palette::C16)).join("\n");
+    assert!(
+        text.contains("threading  pool     3 physics threads"),
+        "{text}"
+    );
+    assert!(!text.contains("threading  off"), "{text}");
+    // One lane is the engine's word: exact ran in split while swept is
+    // asked, and the row says where exact ran.
+    let split = snapshot_at(Settings {
+        threading: Threading::Split,
+        model: ModelKind::Exact,
+        ..settings()
+    });
+    assert!(split.one_lane);
+    let text = rows(&readouts(&st, &split, Palette::C16)).join("\n");
+    assert!(text.contains("split    exact runs on physics"), "{text}");
+    assert!(text.contains("model      exact"), "{text}");
+    // Frozen is the tick that ran: a snapshot of tick 0 beside a state
+    // that asks for 1 (a paused frame keeps the tick, so only tick 0 does).
+    let frozen = snapshot_at(Settings {
+        tick: 0,
+        ..settings()
+    });
+    let text = rows(&readouts(&st, &frozen, Palette::C16)).join("\n");
+    assert!(
+        text.contains("tick       0        steps/frame  frozen"),
+        "{text}"
+    );
+    // Flat out is the screen's: "max" and the tick x goes back to.
+    let mut st = state();
+    st.flat_out = true;
+    st.tick = 7;
+    let text = rows(&readouts(&st, &worker, Palette::C16)).join("\n");
+    assert!(text.contains("max      flat out (x: tick 7)"), "{text}");
+}
+
 #[test]
 fn readouts_show_the_radius_in_force_not_the_one_asked_for() {
     let mut st = state();
     // Asked for 0.5; the snapshot's spheres span 0.08 to 0.15.
     st.radius = 0.5;
-    let t = readouts(&st, &snapshot(), Palette::C16);
+    let t = readouts(&st, &ran(&st), Palette::C16);
     let text = rows(&t).join("\n");
     assert!(text.contains("radius     0.08000-0.15000"), "{text}");
     assert!(!text.contains("0.50000"), "{text}");
@@ -603,13 +704,13 @@ fn readouts_show_the_radius_in_force_not_the_one_asked_for() {
 fn paused_and_frozen_say_so_instead_of_a_frame_rate() {
     let mut st = state();
     st.paused = true;
-    let text = rows(&readouts(&st, &snapshot(), Palette::C16)).join("\n");
+    let text = rows(&readouts(&st, &ran(&st), Palette::C16)).join("\n");
     assert!(text.contains("fps        paused"), "{text}");
     assert!(!text.contains("29.9"), "{text}");
     assert!(text.contains("physics    idle"), "{text}");
     let mut st = state();
     st.tick = 0;
-    let text = rows(&readouts(&st, &snapshot(), Palette::C16)).join("\n");
+    let text = rows(&readouts(&st, &ran(&st), Palette::C16)).join("\n");
     assert!(text.contains("fps        frozen (tick 0)"), "{text}");
     // The compact form too.
     let t = screen(80, 24, &st, &report_for(Threading::Pool, 2));
@@ -625,7 +726,7 @@ fn a_long_notice_wraps_instead_of_being_cut() {
     let r = report_for(Threading::Pool, 2);
     let small = ballpit::tui::app::areas(ratatui::layout::Rect::new(0, 0, 80, 24), &r).unwrap();
     for (t, x0) in [
-        (readouts(&st, &snapshot(), Palette::C16), 0),
+        (readouts(&st, &ran(&st), Palette::C16), 0),
         (screen(80, 24, &st, &r), small.readouts.x),
     ] {
         let text: String = rows(&t)

@@ -1,10 +1,11 @@
 //! Every key's effect on the app state, without a terminal.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
-use ballpit::engine::{Command, Settings, Threading};
+use ballpit::engine::{Command, Settings, Snapshot, Threading};
 use ballpit::physics::ModelKind;
 use ballpit::tui::canvas::{DrawStyle, LIGHT_STEPS};
 use ballpit::tui::keys::{Action, Press, lookup};
 use ballpit::tui::state::{AppState, CAMERA_STEP, MAX_PITCH, MAX_TICK, MIN_RADIUS, RADIUS_STEP};
+use std::sync::LazyLock;
 
 fn settings() -> Settings {
     Settings {
@@ -20,9 +21,31 @@ fn app() -> AppState {
     AppState::new(&settings(), 1000, 0.02, 30.0)
 }
 
+/// What ran before the keys: the engine's first snapshot of a small scene
+/// at `settings()`.
+fn ran() -> &'static Snapshot {
+    static RAN: LazyLock<Snapshot> = LazyLock::new(|| ran_with(settings()));
+    &RAN
+}
+
+fn ran_with(s: Settings) -> Snapshot {
+    use ballpit::physics::{Sphere, World};
+    use glam::DVec3;
+    let spheres = vec![Sphere::new(DVec3::splat(0.5), DVec3::X, 0.05)];
+    ballpit::engine::Engine::new(World::new(1.0, spheres), s)
+        .unwrap()
+        .snapshot()
+        .clone()
+}
+
 fn key(app: &mut AppState, press: Press) -> Vec<Command> {
+    key_after(app, press, ran())
+}
+
+/// A key pressed with `ran` the latest snapshot.
+fn key_after(app: &mut AppState, press: Press, ran: &Snapshot) -> Vec<Command> {
     let a = lookup(press).expect("a mapped key");
-    app.apply(a)
+    app.apply(a, ran)
 }
 
 #[test]
@@ -34,7 +57,7 @@ fn q_esc_and_ctrl_c_quit() {
     }
     let mut a = app();
     let ctrl_c = lookup(Press::Ctrl('c')).unwrap();
-    a.apply(ctrl_c);
+    a.apply(ctrl_c, ran());
     assert!(a.quit);
 }
 
@@ -111,15 +134,15 @@ fn p_and_shift_p_change_the_pool_within_limits() {
 #[test]
 fn brackets_change_the_tick_and_zero_freezes() {
     let mut a = app();
-    // The tick goes to the engine at the next frame (0 while paused), so the
-    // key itself sends nothing.
-    assert!(key(&mut a, Press::Char(']')).is_empty());
+    // The tick goes to the engine like any setting, so the snapshot that
+    // answers it says the tick that ran.
+    assert_eq!(key(&mut a, Press::Char(']')), [Command::SetTick(2)]);
     assert_eq!(a.tick, 2);
     key(&mut a, Press::Char('['));
-    key(&mut a, Press::Char('['));
+    assert_eq!(key(&mut a, Press::Char('[')), [Command::SetTick(0)]);
     assert_eq!(a.tick, 0);
     assert!(!a.running());
-    key(&mut a, Press::Char('['));
+    assert!(key(&mut a, Press::Char('[')).is_empty());
     assert_eq!(a.tick, 0);
     assert!(a.notice.as_deref().unwrap().contains("frozen"));
     a.tick = MAX_TICK;
@@ -227,10 +250,10 @@ fn f_and_shift_f_step_the_frame_rate() {
     key(&mut a, Press::Char('f'));
     assert_eq!(a.fps, 20.0);
     let mut b = AppState::new(&settings(), 10, 0.1, 24.0);
-    b.apply(Action::FasterFps);
+    b.apply(Action::FasterFps, ran());
     assert_eq!(b.fps, 30.0);
     for _ in 0..10 {
-        b.apply(Action::SlowerFps);
+        b.apply(Action::SlowerFps, ran());
     }
     assert_eq!(b.fps, 5.0);
 }
@@ -305,19 +328,63 @@ fn p_while_not_in_pool_mode_keeps_the_size_and_says_where_it_applies() {
     a.threading = Threading::Pool;
     assert_eq!(key(&mut a, Press::Char('p')), [Command::SetThreads(4)]);
     assert!(a.notice.is_none());
-    // In pool mode with exact, the size has no effect either.
+    // In pool mode with exact, the size has no effect either: the engine
+    // said exact ran on one lane.
+    let exact = ran_with(Settings {
+        model: ModelKind::Exact,
+        ..settings()
+    });
+    assert!(exact.one_lane);
     a.model = ModelKind::Exact;
-    key(&mut a, Press::Char('P'));
+    key_after(&mut a, Press::Char('P'), &exact);
     assert!(a.notice.as_deref().unwrap().contains("exact"));
+    // Another model asked since: the snapshot cannot say, so no claim.
+    a.model = ModelKind::Swept;
+    key_after(&mut a, Press::Char('P'), &exact);
+    assert!(a.notice.is_none());
 }
 
 #[test]
 fn tick_keys_while_paused_say_the_tick_runs_on_resume() {
     let mut a = app();
-    key(&mut a, Press::Char(' '));
-    key(&mut a, Press::Char(']'));
+    // The pause is the loop's to hold: the engine keeps its tick.
+    assert!(key(&mut a, Press::Char(' ')).is_empty());
+    // Paused, the tick is sent all the same: the held frame that answers
+    // it runs no step but shows the tick the resume runs.
+    assert_eq!(key(&mut a, Press::Char(']')), [Command::SetTick(2)]);
     assert_eq!(a.tick, 2);
     assert!(a.notice.as_deref().unwrap().contains("resumed"));
+    assert!(key(&mut a, Press::Char(' ')).is_empty());
+}
+
+/// The pause as the loop holds it: a held frame applies the commands and
+/// answers them with a fresh snapshot, but runs no step, and its settings
+/// keep the tick for the resume (no tick 0 stands in for the pause).
+#[test]
+fn a_held_frame_answers_commands_without_a_step_and_keeps_the_tick() {
+    use ballpit::engine::Engine;
+    use ballpit::physics::{Sphere, World};
+    use glam::DVec3;
+    let spheres = vec![Sphere::new(DVec3::splat(0.5), DVec3::X, 0.05)];
+    let mut e = Engine::new(World::new(1.0, spheres), settings()).unwrap();
+    e.start_frame().unwrap();
+    let t = e.finish_frame().unwrap().time;
+    e.set_hold(true);
+    e.command(Command::SetTick(7));
+    e.command(Command::SetThreading(Threading::Worker));
+    e.start_frame().unwrap();
+    let snap = e.finish_frame().unwrap();
+    assert_eq!((snap.frame, snap.steps, snap.time), (2, 0, t));
+    assert_eq!(
+        (snap.settings.tick, snap.settings.threading),
+        (7, Threading::Worker)
+    );
+    assert_eq!(snap.physics_threads, ["physics"]);
+    e.set_hold(false);
+    e.start_frame().unwrap();
+    let snap = e.finish_frame().unwrap();
+    assert_eq!((snap.steps, snap.settings.tick), (7, 7));
+    assert!(snap.time > t);
 }
 
 #[test]
@@ -325,16 +392,16 @@ fn x_toggles_flat_out_and_goes_back_to_the_tick_before() {
     let mut a = app();
     a.tick = 0;
     assert!(!a.running());
-    key(&mut a, Press::Char('x'));
-    assert!(a.flat_out && a.running());
     // Flat out needs a tick above 0 for the engine; the tick is kept.
+    assert_eq!(key(&mut a, Press::Char('x')), [Command::SetTick(1)]);
+    assert!(a.flat_out && a.running());
     assert_eq!((a.tick, a.engine_tick()), (0, 1));
     assert!(a.notice.as_deref().unwrap().contains("flat out"));
     // The tick keys leave the tick alone while flat out, and say so.
     key(&mut a, Press::Char(']'));
     assert_eq!(a.tick, 0);
     assert!(a.notice.as_deref().unwrap().contains("x goes back"));
-    key(&mut a, Press::Char('x'));
+    assert_eq!(key(&mut a, Press::Char('x')), [Command::SetTick(0)]);
     assert!(!a.flat_out && !a.running());
 }
 
@@ -448,9 +515,11 @@ fn sync_shows_auto_s_switch_after_the_key_s_answer_and_takes_what_it_runs() {
     // No key of ours: the switch alone.
     a.sync(&snap, false);
     assert_eq!(a.notice.as_deref(), Some("auto: swept → exact (dense)"));
-    assert_eq!(a.running_model(), ModelKind::Exact);
-    // `exact` runs, so the pool size does nothing to it: the key says so.
-    key(&mut a, Press::Char('P'));
+    // `exact` ran, on one lane as the engine says, so the pool size does
+    // nothing to it: the key says so.
+    snap.one_lane = true;
+    assert_eq!(snap.model_ran(), ModelKind::Exact);
+    key_after(&mut a, Press::Char('P'), &snap);
     assert!(
         a.notice
             .as_deref()
@@ -469,7 +538,8 @@ fn sync_shows_auto_s_switch_after_the_key_s_answer_and_takes_what_it_runs() {
     snap.switch_notice = None;
     a.sync(&snap, false);
     assert_eq!(a.notice.as_deref(), Some(n.as_str()));
-    // Another model: what runs is the model itself.
+    // Another model asked: auto's choice no longer speaks for it.
     key(&mut a, Press::Char('m'));
-    assert_eq!(a.running_model(), ModelKind::Discrete);
+    key_after(&mut a, Press::Char('P'), &snap);
+    assert!(!a.notice.as_deref().unwrap_or("").contains("one thread"));
 }
