@@ -81,6 +81,32 @@ fn a_wide_tail_does_not_size_the_bulks_cells() {
     assert_eq!(with_tail[0].1, n - n / 25, "the bulk stays: {with_tail:?}");
 }
 
+/// Radii spread evenly (log-uniform over 50×): the first level is sized
+/// for a share of them below the widest, where its cells hold the bulk
+/// once, not for the 98th percentile, where they held it dozens of times.
+#[test]
+fn a_smooth_spread_of_radii_gets_levels_of_its_own() {
+    let n = 20_000;
+    let f = |k: usize, m: usize| ((k * m + 7) % 10_007) as f64 / 10_007.0;
+    let (r0, spread) = (0.0005, 50.0_f64);
+    let balls: Vec<Sphere> = (0..n)
+        .map(|k| {
+            let p = DVec3::new(f(k, 7_919), f(k, 104_729), f(k, 1_299_709));
+            Sphere::new(p, DVec3::ZERO, r0 * spread.powf(f(k, 15_485_863)))
+        })
+        .collect();
+    let mut grid = Grid::default();
+    grid.build(&balls, 1.0, |b| (b.pos, b.radius), &Serial);
+    let (levels, _) = grid.shape();
+    // Cells a side for the 98th percentile radius, as before.
+    let at_98 = (1.0 / (2.0 * r0 * spread.powf(0.98))).floor() as usize;
+    assert!(
+        levels[0].0 > 2 * at_98,
+        "first level {levels:?}, {at_98} a side at the 98th percentile"
+    );
+    assert!(levels.len() >= 2, "the wider go up: {levels:?}");
+}
+
 fn check(balls: &[((f64, f64, f64), f64)]) -> Result<(), TestCaseError> {
     let spheres: Vec<Sphere> = balls
         .iter()

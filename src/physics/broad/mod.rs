@@ -1,7 +1,8 @@
 //! Broad phase: which pairs can touch within a step. A hierarchy of uniform
 //! grids: the first level's cell is sized for the bulk of the spheres (the
-//! 98th percentile of their reach); the ones that do not fit go up to a
-//! coarser level sized the same way among themselves, and so on, and the last
+//! share of their reaches that predicts the least work, `sizing.rs`); the
+//! ones that do not fit go up to a coarser level sized the same way among
+//! themselves, and so on, and the last
 //! handful are tested against everything. A sphere of a coarse level meets
 //! the finer levels by querying their cells over its own reach, so radii or
 //! speeds spread over orders of magnitude stay about linear in cost. Tiny
@@ -10,12 +11,14 @@ mod entry;
 mod level;
 mod pairs;
 mod place;
+mod sizing;
 
 use super::exec::{Exec, PerBlock, for_each_chunk};
 use super::sphere::Sphere;
 use entry::{Ball, Entry, Source};
 use glam::DVec3;
 use level::{Level, WIDE};
+use sizing::{cell_for, cell_of_sample};
 
 /// At most this many spheres are tested against everything.
 const ALL_PAIRS_MAX: usize = 24;
@@ -23,13 +26,6 @@ const ALL_PAIRS_MAX: usize = 24;
 const LANES_MIN_SPHERES: usize = 4096;
 /// Spheres per parallel block while binning.
 const BUILD_BLOCK: usize = 4096;
-/// A level's cell is sized for its 90th percentile reach, not its 98th,
-/// when the 98th is this many times wider: a cell's candidates grow with its
-/// volume, and cells four times the bulk's (1.6³) for the widest tenth cost
-/// every sphere of the level more than those few cost a level up (a scene
-/// whose light spheres outran its heavy ones 10× spent two thirds of its
-/// step in crowded cells; docs/perf-log.md, 2026-12-04).
-const TAIL_SPREAD: f64 = 1.6;
 /// The first level's cell comes from every this-many-th reach.
 const SAMPLE_STRIDE: usize = 32;
 /// From this many spheres on, the first level is staged as cell keys alone
@@ -86,42 +82,6 @@ impl<T: Sync, B: Fn(&T) -> (DVec3, f64) + Sync> Source for Keyed<'_, T, B> {
         None
     }
 }
-/// Twice the 98th percentile of `reach` (estimated on every `stride`-th
-/// value: a function of the state only, so the grid, and the order pairs
-/// come out in, never depend on history), or twice `max` when the fastest is
-/// close to the bulk, or twice the 90th percentile when the top tenth
-/// spreads past [`TAIL_SPREAD`] times it.
-fn cell_for(
-    reaches: impl Iterator<Item = f64>,
-    max: f64,
-    stride: usize,
-    scratch: &mut Vec<f64>,
-) -> f64 {
-    scratch.clear();
-    scratch.extend(reaches.step_by(stride));
-    cell_of_sample(scratch, max)
-}
-
-/// [`cell_for`] of reaches already sampled into `scratch` (reordered);
-/// `max` is the widest reach known (for the first level, the sample's: a
-/// sphere wider than the cell then goes up a level, as any would).
-fn cell_of_sample(scratch: &mut [f64], max: f64) -> f64 {
-    if scratch.is_empty() {
-        return 2.0 * max;
-    }
-    let k = (scratch.len() * 98 / 100).min(scratch.len() - 1);
-    let mut q = *scratch.select_nth_unstable_by(k, f64::total_cmp).1;
-    // Everything below `k` is at most `q`: the 90th percentile is there.
-    let k90 = scratch.len() * 90 / 100;
-    if k90 < k {
-        let q90 = *scratch[..k].select_nth_unstable_by(k90, f64::total_cmp).1;
-        if q > TAIL_SPREAD * q90 {
-            q = q90;
-        }
-    }
-    // When the fastest is close to the bulk, one level holds everyone.
-    2.0 * if max <= 1.25 * q { max } else { q }
-}
 
 impl Grid {
     /// Bin the spheres (or any items with a ball). `ball(s)` is a centre and
@@ -173,7 +133,7 @@ impl Grid {
         self.scratch
             .extend(spheres.iter().step_by(SAMPLE_STRIDE).map(|s| ball(s).1));
         let max = self.scratch.iter().fold(0.0f64, |m, &r| m.max(r));
-        let want = cell_of_sample(&mut self.scratch, max);
+        let want = cell_of_sample(&mut self.scratch, max, n, self.size);
         self.levels[0].shape(self.size, want, n, true);
         self.rest.clear();
         if n >= KEYED_MIN {
@@ -261,6 +221,8 @@ impl Grid {
                 self.rest.iter().map(|b| b.0.reach),
                 max,
                 1,
+                self.rest.len(),
+                size,
                 &mut self.scratch,
             );
             let level = &mut self.levels[depth];
