@@ -7,3 +7,4 @@ pub mod link;
 pub mod names;
 pub mod pty;
 pub mod random_scene;
+pub mod screen;

@@ -454,10 +454,7 @@ fn the_model_row_says_what_auto_runs() {
         );
     })
     .unwrap();
-    let buf = t.backend().buffer();
-    let text: Vec<String> = (0..buf.area.height)
-        .map(|y| (0..buf.area.width).map(|x| buf[(x, y)].symbol()).collect())
-        .collect();
+    let text = crate::common::screen::rows(&t);
     let row = text.iter().find(|r| r.contains("model")).unwrap();
     assert!(row.contains("auto → exact (dense:"), "{text:#?}");
 }
