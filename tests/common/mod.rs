@@ -1,6 +1,7 @@
 //! Helpers shared by the test crates (`tests/physics`, `tests/engine`,
 //! `tests/app`), each declaring this module once.
 pub mod bits;
+pub mod child;
 pub mod json;
 pub mod large;
 pub mod link;
