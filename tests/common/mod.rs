@@ -2,6 +2,7 @@
 //! `tests/app`), each declaring this module once.
 pub mod bits;
 pub mod child;
+pub mod cli;
 pub mod json;
 pub mod large;
 pub mod link;

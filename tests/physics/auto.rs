@@ -357,11 +357,7 @@ fn auto_names_the_threads_of_the_model_it_runs() {
 }
 
 fn ballpit(args: &[&str]) -> std::process::Output {
-    assert_cmd::Command::cargo_bin("ballpit")
-        .unwrap()
-        .args(args)
-        .output()
-        .unwrap()
+    crate::common::cli::ballpit().args(args).output().unwrap()
 }
 
 /// `--tolerance` out of [0, 1] is refused with one line and exit 2; with
