@@ -6,6 +6,8 @@
 //! at random moments, the frames per second shown by the app, and the
 //! bytes per second and per frame the screen received.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap fails the run
+#[path = "../tests/common/child.rs"]
+mod child;
 #[path = "../tests/common/link.rs"]
 mod link;
 

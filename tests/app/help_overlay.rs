@@ -2,9 +2,10 @@
 //! draws at: read back from the drawn screen, each binding's keys and its
 //! description, in the table's order, in one column or two.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+use crate::common::screen;
 use ballpit::cpu::{CpuReport, ThreadLoad, ThreadRole};
-use ballpit::engine::{Engine, Settings, Threading};
-use ballpit::physics::{ModelKind, Sphere, World};
+use ballpit::engine::Engine;
+use ballpit::physics::{Sphere, World};
 use ballpit::tui::app::{self, MIN_HEIGHT, MIN_WIDTH, View};
 use ballpit::tui::canvas::Raster;
 use ballpit::tui::keys::TABLE;
@@ -19,13 +20,7 @@ use ratatui::backend::TestBackend;
 const KEY_W: usize = 10;
 
 fn screen(w: u16, h: u16) -> Vec<Vec<char>> {
-    let settings = Settings {
-        model: ModelKind::Swept,
-        dt: 1.0 / 60.0,
-        tick: 1,
-        threading: Threading::Off,
-        threads: 2,
-    };
+    let settings = screen::settings(2);
     let spheres = vec![Sphere::new(DVec3::splat(0.5), DVec3::X, 0.1)];
     let engine = Engine::new(World::new(1.0, spheres), settings).unwrap();
     let mut state = AppState::new(&settings, 1, 0.1, 30.0);

@@ -2,7 +2,9 @@
 //! terminal without colours gets no colour escape, and the size message
 //! fits at any size (the real binary in a real pty).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
-use portable_pty::{CommandBuilder, PtySize, native_pty_system};
+use crate::common::child::wait_exit;
+use crate::common::pty;
+use portable_pty::CommandBuilder;
 use std::io::{Read, Write};
 use std::sync::{Arc, Mutex};
 use std::thread;
@@ -16,14 +18,7 @@ fn run(
     (rows, cols): (u16, u16),
     ready: fn(&str) -> bool,
 ) -> (String, Vec<u8>) {
-    let pty = native_pty_system()
-        .openpty(PtySize {
-            rows,
-            cols,
-            pixel_width: 0,
-            pixel_height: 0,
-        })
-        .unwrap();
+    let pty = pty::open((rows, cols));
     let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_ballpit"));
     cmd.env_remove("NO_COLOR");
     cmd.env_remove("LC_ALL");
@@ -49,11 +44,7 @@ fn run(
         }
     });
     let screen = |raw: &[u8]| {
-        let mut p = vt100::Parser::new(
-            std::num::NonZeroU16::new(rows).unwrap(),
-            std::num::NonZeroU16::new(cols).unwrap(),
-            0,
-        );
+        let mut p = vt100::Parser::new(pty::nz(rows), pty::nz(cols), 0);
         p.process(raw);
         p.screen().contents()
     };
@@ -75,11 +66,7 @@ fn run(
     };
     writer.write_all(b"q").unwrap();
     writer.flush().unwrap();
-    let end = Instant::now() + Duration::from_secs(20);
-    while child.try_wait().unwrap().is_none() {
-        assert!(Instant::now() < end, "q did not end the app");
-        thread::sleep(Duration::from_millis(20));
-    }
+    wait_exit(&mut *child, 20.0, Duration::from_millis(20)).expect("q did not end the app");
     thread::sleep(Duration::from_millis(100));
     let bytes = raw.lock().unwrap().clone();
     (text, bytes)

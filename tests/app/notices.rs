@@ -5,6 +5,7 @@
 //! resets, the memory check's screen form, the pause and the event cap.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use crate::common::names::thread_names;
+use crate::common::screen;
 use ballpit::cpu::{CpuReport, ThreadLoad, ThreadRole};
 use ballpit::engine::{Command, Engine, MAX_THREADS, Settings, Snapshot, Threading};
 use ballpit::physics::{ModelKind, Sphere, World, edit};
@@ -26,10 +27,8 @@ use std::collections::BTreeMap;
 fn settings(model: ModelKind, threading: Threading) -> Settings {
     Settings {
         model,
-        dt: 1.0 / 60.0,
-        tick: 1,
         threading,
-        threads: 2,
+        ..screen::settings(2)
     }
 }
 
@@ -308,14 +307,7 @@ fn shown(
     };
     let (rows, outside) = notice_cells(&t, inner);
     assert!(!outside, "{notice:?} at {w}x{h}: drawn outside the panel");
-    let screen = t
-        .backend()
-        .buffer()
-        .content()
-        .iter()
-        .map(ratatui::buffer::Cell::symbol)
-        .collect();
-    (rows, inner, screen)
+    (rows, inner, screen::text(&t))
 }
 
 /// `rows` hold `text` whole: nothing lost, in order, and every word that

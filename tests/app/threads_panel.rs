@@ -3,6 +3,7 @@
 //! every figure with its `%` and base, the pool's own total, and the grid
 //! only where the rows run out.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+use crate::common::screen::{rows, settings};
 use ballpit::cpu::{CpuReport, ThreadLoad, ThreadRole};
 use ballpit::tui::app;
 use ballpit::tui::theme::Palette;
@@ -50,13 +51,6 @@ fn report(pool: usize) -> CpuReport {
         cores: 2,
         others_percent: Some(37.5),
     }
-}
-
-fn rows(t: &Terminal<TestBackend>) -> Vec<String> {
-    let buf = t.backend().buffer();
-    (0..buf.area.height)
-        .map(|y| (0..buf.area.width).map(|x| buf[(x, y)].symbol()).collect())
-        .collect()
 }
 
 #[test]
@@ -199,13 +193,7 @@ fn s_sorts_the_rows_by_cpu_and_back() {
     assert!(at(&busy, "main") < at(&busy, "physics"), "{busy:#?}");
     assert!(busy[0].contains("threads by CPU"), "{busy:#?}");
     // The key toggles the state the panel reads.
-    let settings = ballpit::engine::Settings {
-        model: ballpit::physics::ModelKind::Swept,
-        dt: 1.0 / 60.0,
-        tick: 1,
-        threading: ballpit::engine::Threading::Off,
-        threads: 2,
-    };
+    let settings = settings(2);
     let mut st = AppState::new(&settings, 4, 0.1, 30.0);
     let ran = ballpit::engine::Engine::new(ballpit::physics::World::new(1.0, Vec::new()), settings)
         .unwrap()

@@ -1,11 +1,10 @@
 //! Started without a terminal, the app says so and exits 2.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
-use assert_cmd::Command;
+use crate::common::cli::ballpit;
 
 #[test]
 fn without_a_tty_it_suggests_bench_and_exits_2() {
-    let out = Command::cargo_bin("ballpit")
-        .unwrap()
+    let out = ballpit()
         .write_stdin("")
         .timeout(std::time::Duration::from_secs(10))
         .output()
@@ -27,8 +26,7 @@ fn without_a_tty_it_suggests_bench_and_exits_2() {
 #[test]
 fn a_bad_fps_or_colour_is_bad_input() {
     for (flag, value, says) in [("--fps", "0", "--fps"), ("--color", "99", "--color")] {
-        let out = Command::cargo_bin("ballpit")
-            .unwrap()
+        let out = ballpit()
             .args([flag, value])
             .write_stdin("")
             .timeout(std::time::Duration::from_secs(10))

@@ -1,6 +1,7 @@
 //! The screen parts at a fixed state, drawn on ratatui's `TestBackend`.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use crate::common::names::thread_names;
+use crate::common::screen::{rows, settings, text};
 use ballpit::cpu::{CpuReport, ThreadLoad, ThreadRole};
 use ballpit::engine::{Engine, Settings, Snapshot, Threading};
 use ballpit::physics::{ModelKind, Sphere, World};
@@ -17,18 +18,8 @@ use ratatui::Terminal;
 use ratatui::backend::TestBackend;
 use ratatui::style::Color;
 
-fn settings() -> Settings {
-    Settings {
-        model: ModelKind::Swept,
-        dt: 1.0 / 60.0,
-        tick: 1,
-        threading: Threading::Off,
-        threads: 2,
-    }
-}
-
 fn snapshot() -> Snapshot {
-    snapshot_at(settings())
+    snapshot_at(settings(2))
 }
 
 /// The snapshot of a frame that ran with the settings `st` asked for: the
@@ -39,7 +30,7 @@ fn ran(st: &AppState) -> Snapshot {
         tick: st.engine_tick(),
         threading: st.threading,
         threads: st.threads,
-        ..settings()
+        ..settings(2)
     })
 }
 
@@ -126,7 +117,7 @@ fn report_for(mode: Threading, pool: usize) -> CpuReport {
 }
 
 fn state() -> AppState {
-    AppState::new(&settings(), 4, 0.15, 30.0)
+    AppState::new(&settings(2), 4, 0.15, 30.0)
 }
 
 fn render(w: u16, h: u16, f: impl FnOnce(&mut ratatui::Frame)) -> Terminal<TestBackend> {
@@ -320,13 +311,7 @@ fn small_canvas_shaded() {
 fn small_canvas_shaded_without_colour_uses_a_glyph_ramp() {
     let t = canvas(DrawStyle::Shaded, Palette::Mono);
     insta::assert_snapshot!(t.backend());
-    let text: String = t
-        .backend()
-        .buffer()
-        .content()
-        .iter()
-        .map(ratatui::buffer::Cell::symbol)
-        .collect();
+    let text = text(&t);
     assert!(text.contains('@') && text.contains('+'), "{text}");
 }
 
@@ -346,14 +331,6 @@ fn whole_screen_and_the_too_small_message() {
     insta::assert_snapshot!("whole_screen", t.backend());
     let t = render(60, 12, |f| app::draw(f, &mut raster, &view));
     insta::assert_snapshot!("too_small", t.backend());
-}
-
-/// The screen's rows as text.
-fn rows(t: &Terminal<TestBackend>) -> Vec<String> {
-    let buf = t.backend().buffer();
-    (0..buf.area.height)
-        .map(|y| (0..buf.area.width).map(|x| buf[(x, y)].symbol()).collect())
-        .collect()
 }
 
 const CELLS: &str = "·▁▂▃▄▅▆▇█";
@@ -631,7 +608,7 @@ fn readouts_show_the_mode_threads_model_and_tick_that_ran_not_those_asked() {
     let worker = snapshot_at(Settings {
         threading: Threading::Worker,
         tick: 2,
-        ..settings()
+        ..settings(2)
     });
     let text = rows(&readouts(&st, &worker, Palette::C16)).join("\n");
     assert!(
@@ -650,7 +627,7 @@ fn readouts_show_the_mode_threads_model_and_tick_that_ran_not_those_asked() {
     let pool = snapshot_at(Settings {
         threading: Threading::Pool,
         threads: 3,
-        ..settings()
+        ..settings(2)
     });
     assert_eq!(pool.physics_threads, ["pool-0", "pool-1", "pool-2"]);
     let text = rows(&readouts(&st, &pool, Palette::C16)).join("\n");
@@ -664,7 +641,7 @@ fn readouts_show_the_mode_threads_model_and_tick_that_ran_not_those_asked() {
     let split = snapshot_at(Settings {
         threading: Threading::Split,
         model: ModelKind::Exact,
-        ..settings()
+        ..settings(2)
     });
     assert!(split.one_lane);
     let text = rows(&readouts(&st, &split, Palette::C16)).join("\n");
@@ -674,7 +651,7 @@ fn readouts_show_the_mode_threads_model_and_tick_that_ran_not_those_asked() {
     // that asks for 1 (a paused frame keeps the tick, so only tick 0 does).
     let frozen = snapshot_at(Settings {
         tick: 0,
-        ..settings()
+        ..settings(2)
     });
     let text = rows(&readouts(&st, &frozen, Palette::C16)).join("\n");
     assert!(

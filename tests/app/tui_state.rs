@@ -1,5 +1,6 @@
 //! Every key's effect on the app state, without a terminal.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+use crate::common::screen::settings;
 use ballpit::engine::{Command, Settings, Snapshot, Threading};
 use ballpit::physics::ModelKind;
 use ballpit::tui::canvas::{DrawStyle, LIGHT_STEPS};
@@ -7,24 +8,14 @@ use ballpit::tui::keys::{Action, Press, lookup};
 use ballpit::tui::state::{AppState, CAMERA_STEP, MAX_PITCH, MAX_TICK, MIN_RADIUS, RADIUS_STEP};
 use std::sync::LazyLock;
 
-fn settings() -> Settings {
-    Settings {
-        model: ModelKind::Swept,
-        dt: 1.0 / 60.0,
-        tick: 1,
-        threading: Threading::Off,
-        threads: 4,
-    }
-}
-
 fn app() -> AppState {
-    AppState::new(&settings(), 1000, 0.02, 30.0)
+    AppState::new(&settings(4), 1000, 0.02, 30.0)
 }
 
 /// What ran before the keys: the engine's first snapshot of a small scene
-/// at `settings()`.
+/// at `settings(4)`.
 fn ran() -> &'static Snapshot {
-    static RAN: LazyLock<Snapshot> = LazyLock::new(|| ran_with(settings()));
+    static RAN: LazyLock<Snapshot> = LazyLock::new(|| ran_with(settings(4)));
     &RAN
 }
 
@@ -249,7 +240,7 @@ fn f_and_shift_f_step_the_frame_rate() {
     key(&mut a, Press::Char('f'));
     key(&mut a, Press::Char('f'));
     assert_eq!(a.fps, 20.0);
-    let mut b = AppState::new(&settings(), 10, 0.1, 24.0);
+    let mut b = AppState::new(&settings(4), 10, 0.1, 24.0);
     b.apply(Action::FasterFps, ran());
     assert_eq!(b.fps, 30.0);
     for _ in 0..10 {
@@ -260,7 +251,7 @@ fn f_and_shift_f_step_the_frame_rate() {
 
 #[test]
 fn threading_given_on_the_command_line_is_what_t_returns_to() {
-    let mut s = settings();
+    let mut s = settings(4);
     s.threading = Threading::Split;
     let mut a = AppState::new(&s, 10, 0.1, 30.0);
     key(&mut a, Press::Char('t'));
@@ -278,7 +269,7 @@ fn sync_takes_the_real_count_radius_and_the_engine_notice() {
         Sphere::new(DVec3::splat(0.3), DVec3::X, 0.05),
         Sphere::new(DVec3::splat(0.7), DVec3::Y, 0.1),
     ];
-    let engine = Engine::new(World::new(1.0, spheres), settings()).unwrap();
+    let engine = Engine::new(World::new(1.0, spheres), settings(4)).unwrap();
     let mut snap = engine.snapshot().clone();
     let mut a = app();
     key(&mut a, Press::Char('N'));
@@ -332,7 +323,7 @@ fn p_while_not_in_pool_mode_keeps_the_size_and_says_where_it_applies() {
     // said exact ran on one lane.
     let exact = ran_with(Settings {
         model: ModelKind::Exact,
-        ..settings()
+        ..settings(4)
     });
     assert!(exact.one_lane);
     a.model = ModelKind::Exact;
@@ -366,7 +357,7 @@ fn a_held_frame_answers_commands_without_a_step_and_keeps_the_tick() {
     use ballpit::physics::{Sphere, World};
     use glam::DVec3;
     let spheres = vec![Sphere::new(DVec3::splat(0.5), DVec3::X, 0.05)];
-    let mut e = Engine::new(World::new(1.0, spheres), settings()).unwrap();
+    let mut e = Engine::new(World::new(1.0, spheres), settings(4)).unwrap();
     e.start_frame().unwrap();
     let t = e.finish_frame().unwrap().time;
     e.set_hold(true);
@@ -423,7 +414,7 @@ fn a_key_that_does_nothing_yet_keeps_its_notice_through_the_frame() {
     let mut a = app();
     let mut snap = ballpit::engine::Engine::new(
         ballpit::scene::build_world(&ballpit::scene::SceneSpec::default()).unwrap(),
-        settings(),
+        settings(4),
     )
     .unwrap()
     .snapshot()
@@ -450,7 +441,7 @@ fn angle_brackets_step_auto_s_tolerance_over_the_ladder() {
     let mut a = AppState::new(
         &Settings {
             model: auto(0.0),
-            ..settings()
+            ..settings(4)
         },
         1000,
         0.02,
@@ -501,7 +492,7 @@ fn sync_shows_auto_s_switch_after_the_key_s_answer_and_takes_what_it_runs() {
     let s = Settings {
         model: auto(0.0),
         threading: Threading::Pool,
-        ..settings()
+        ..settings(4)
     };
     let engine = Engine::new(World::new(1.0, spheres), s).unwrap();
     let mut snap = engine.snapshot().clone();

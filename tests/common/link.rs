@@ -4,7 +4,7 @@
 //! device status query (`ESC[5n` → `ESC[0n`), cursor position (`ESC[6n`)
 //! and device attributes (`ESC[c`) only once it has consumed the bytes before
 //! them, as a real terminal does. Shared by `tests/app/slow_link.rs` and
-//! `examples/slow_link.rs`.
+//! `examples/slow_link.rs` (which compiles `child.rs` beside it by path).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 #![allow(dead_code)]
 use crossbeam_channel::{Receiver, Sender, unbounded};
@@ -242,14 +242,7 @@ impl Link {
     }
 
     pub fn wait_exit(&mut self, secs: f64) -> Option<portable_pty::ExitStatus> {
-        let end = Instant::now() + Duration::from_secs_f64(secs);
-        while Instant::now() < end {
-            if let Some(st) = self.child.try_wait().unwrap() {
-                return Some(st);
-            }
-            thread::sleep(Duration::from_millis(5));
-        }
-        None
+        super::child::wait_exit(&mut *self.child, secs, Duration::from_millis(5))
     }
 }
 

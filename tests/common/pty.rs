@@ -2,7 +2,7 @@
 //! start it, type, resize, and wait (with a deadline) for what the screen
 //! shows. Shared by the pty tests.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
-use portable_pty::{CommandBuilder, MasterPty, PtySize, native_pty_system};
+use portable_pty::{CommandBuilder, MasterPty, PtyPair, PtySize, native_pty_system};
 use std::io::{Read, Write};
 use std::sync::{Arc, Mutex};
 use std::thread;
@@ -10,6 +10,18 @@ use std::time::{Duration, Instant};
 
 pub fn nz(n: u16) -> std::num::NonZeroU16 {
     std::num::NonZeroU16::new(n).unwrap()
+}
+
+/// A pseudo-terminal of `rows` x `cols`.
+pub fn open((rows, cols): (u16, u16)) -> PtyPair {
+    native_pty_system()
+        .openpty(PtySize {
+            rows,
+            cols,
+            pixel_width: 0,
+            pixel_height: 0,
+        })
+        .expect("openpty")
 }
 
 pub struct App {
@@ -45,14 +57,7 @@ pub fn start_command(
     (rows, cols): (u16, u16),
     term: &str,
 ) -> App {
-    let pty = native_pty_system()
-        .openpty(PtySize {
-            rows,
-            cols,
-            pixel_width: 0,
-            pixel_height: 0,
-        })
-        .expect("openpty");
+    let pty = open((rows, cols));
     cmd.env("TERM", term);
     cmd.env_remove("NO_COLOR");
     let child = pty.slave.spawn_command(cmd).expect("spawn ballpit");
@@ -162,14 +167,7 @@ impl App {
     }
 
     pub fn wait_exit(&mut self, secs: f64) -> Option<portable_pty::ExitStatus> {
-        let end = Instant::now() + Duration::from_secs_f64(secs);
-        while Instant::now() < end {
-            if let Some(st) = self.child.try_wait().unwrap() {
-                return Some(st);
-            }
-            thread::sleep(Duration::from_millis(20));
-        }
-        None
+        super::child::wait_exit(&mut *self.child, secs, Duration::from_millis(20))
     }
 
     /// Press `q` and check the app exits 0 within 5 s.

@@ -1,11 +1,7 @@
 //! The binary's command line: bench JSON, --dump, and bad input (exit 2).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+use crate::common::cli::{ballpit, scratch};
 use crate::common::json;
-use assert_cmd::Command;
-
-fn ballpit() -> Command {
-    Command::cargo_bin("ballpit").unwrap()
-}
 
 #[test]
 fn bench_prints_one_json_line_with_every_field() {
@@ -66,7 +62,7 @@ fn an_empty_box_reads_zero_not_minus_zero() {
 
 #[test]
 fn dump_reads_back_as_the_same_scene() {
-    let dir = std::env::temp_dir().join(format!("ballpit-cli-{}", std::process::id()));
+    let dir = scratch("cli");
     std::fs::create_dir_all(&dir).unwrap();
     // Upper case reads as the same file type, as the screen's check has it.
     let a = dir.join("a.csv");
@@ -98,7 +94,7 @@ fn dump_reads_back_as_the_same_scene() {
 #[test]
 #[allow(clippy::too_many_lines)] // one table of bad inputs and what each must say
 fn bad_input_exits_2_with_one_clear_message() {
-    let dir = std::env::temp_dir().join(format!("ballpit-bad-{}", std::process::id()));
+    let dir = scratch("bad");
     std::fs::create_dir_all(&dir).unwrap();
     let overlap = dir.join("overlap.csv");
     std::fs::write(
@@ -233,7 +229,7 @@ fn bad_input_exits_2_with_one_clear_message() {
 
 #[test]
 fn bench_runs_every_threading_mode_to_the_same_bits() {
-    let dir = std::env::temp_dir().join(format!("ballpit-modes-{}", std::process::id()));
+    let dir = scratch("modes");
     std::fs::create_dir_all(&dir).unwrap();
     let mut dumps = Vec::new();
     for (mode, first) in [

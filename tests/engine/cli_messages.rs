@@ -2,12 +2,8 @@
 //! works: empty scene files, huge numbers, flags that do nothing, flags in
 //! the wrong place, the no-terminal message.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+use crate::common::cli::{ballpit, scratch};
 use crate::common::json;
-use assert_cmd::Command;
-
-fn ballpit() -> Command {
-    Command::cargo_bin("ballpit").unwrap()
-}
 
 /// Stderr and exit code of `ballpit args`, stdin empty.
 fn run(args: &[&str]) -> (String, Option<i32>, Vec<u8>) {
@@ -20,7 +16,7 @@ fn run(args: &[&str]) -> (String, Option<i32>, Vec<u8>) {
 }
 
 fn temp(name: &str, text: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("ballpit-msg-{}", std::process::id()));
+    let dir = scratch("msg");
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(name);
     std::fs::write(&path, text).unwrap();

@@ -1,6 +1,6 @@
 //! `ballpit tradeoff` end to end on a small scene.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
-use assert_cmd::Command;
+use crate::common::cli::{ballpit, scratch};
 use ballpit::physics::ModelKind;
 use ballpit::scene::{SceneSpec, build_world};
 use ballpit::tradeoff::{LADDER, REFERENCE_NOTE, RUN_SECONDS, measure};
@@ -135,9 +135,8 @@ fn the_reference_takes_known_contacts_and_keeps_the_invariants() {
 
 #[test]
 fn cli_writes_the_table_the_csv_and_the_plot() {
-    let dir = std::env::temp_dir().join(format!("ballpit-tradeoff-{}", std::process::id()));
-    let out = Command::cargo_bin("ballpit")
-        .unwrap()
+    let dir = scratch("tradeoff");
+    let out = ballpit()
         .args(["tradeoff", "--count", "60", "--out"])
         .arg(&dir)
         .output()
@@ -163,8 +162,7 @@ fn cli_writes_the_table_the_csv_and_the_plot() {
     assert!(svg.starts_with("<svg") && svg.contains("discrete") && svg.contains("exact"));
     let _ = std::fs::remove_dir_all(&dir);
     // Bad scene flags: exit code 2 and one message.
-    let bad = Command::cargo_bin("ballpit")
-        .unwrap()
+    let bad = ballpit()
         .args(["tradeoff", "--count", "10", "--radius", "0.6"])
         .output()
         .unwrap();

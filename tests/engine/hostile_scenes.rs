@@ -2,7 +2,7 @@
 //! user gave (a flag, a file's key, a file's line), exit code 2, and no
 //! panic, allocation blow-up or quadratic placement.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
-use crate::common::json;
+use crate::common::{cli, json};
 use assert_cmd::Command;
 use ballpit::scene::{SceneSpec, build_world, csv_io, toml_file};
 use std::fmt::Write as _;
@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 const TIMEOUT: Duration = Duration::from_secs(30);
 
 fn ballpit() -> Command {
-    let mut c = Command::cargo_bin("ballpit").unwrap();
+    let mut c = cli::ballpit();
     c.timeout(TIMEOUT);
     c
 }

@@ -5,6 +5,7 @@
 //! the PATH as its install step puts it there, and changes no tracked file;
 //! and its TOML example is a scene ballpit reads.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+use crate::common::cli::scratch;
 use ballpit::cli::{Cli, Command, SceneArgs};
 use ballpit::scene::{self, presets};
 use std::path::{Path, PathBuf};
@@ -241,7 +242,7 @@ fn every_command_the_readme_shows_parses_and_validates() {
 fn the_readme_toml_example_is_a_scene() {
     let examples = blocks(README, "toml");
     assert!(!examples.is_empty(), "the README shows no TOML scene");
-    let dir = std::env::temp_dir().join(format!("ballpit-readme-{}", std::process::id()));
+    let dir = scratch("readme");
     std::fs::create_dir_all(&dir).unwrap();
     for (i, text) in examples.iter().enumerate() {
         let path = dir.join(format!("scene{i}.toml"));
@@ -358,7 +359,7 @@ fn tracked_changes() -> String {
 #[test]
 fn every_readme_command_runs_as_written_and_changes_no_tracked_file() {
     let before = tracked_changes();
-    let dir = std::env::temp_dir().join(format!("ballpit-readme-run-{}", std::process::id()));
+    let dir = scratch("readme-run");
     let bin = dir.join("bin");
     let work = dir.join("work");
     std::fs::create_dir_all(&work).unwrap();

@@ -2,9 +2,9 @@
 //! configuration, the CSV and SVG written, a fitted fraction within [0, 1],
 //! the same bits in every mode, a progress bar on a terminal, and bad input.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+use crate::common::cli::{ballpit, scratch};
 use crate::common::pty;
 
-use assert_cmd::Command;
 use ballpit::engine::Threading;
 use ballpit::scaling::{CSV_COLUMNS, configs};
 use std::time::Duration;
@@ -21,8 +21,7 @@ const TINY: [&str; 8] = [
 ];
 
 fn scaling(args: &[&str]) -> std::process::Output {
-    Command::cargo_bin("ballpit")
-        .unwrap()
+    ballpit()
         .arg("scaling")
         .args(args)
         .timeout(Duration::from_mins(2))
@@ -36,7 +35,7 @@ fn cores() -> usize {
 
 #[test]
 fn a_tiny_sweep_prints_every_column_and_writes_csv_and_svg() {
-    let dir = std::env::temp_dir().join(format!("ballpit-scaling-{}", std::process::id()));
+    let dir = scratch("scaling");
     let out_dir = dir.join("out");
     let mut args = TINY.to_vec();
     args.extend(["--out", out_dir.to_str().unwrap()]);

@@ -5,6 +5,7 @@
 //! `/proc/PID/status` while the process runs: an unbounded read (8 GB in
 //! 20 s before) shows there long before the deadline.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+use crate::common::cli::scratch;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::thread;
@@ -19,7 +20,7 @@ const DEADLINE: Duration = Duration::from_secs(10);
 const MAX_RSS_KB: u64 = 200 * 1024;
 
 fn dir(test: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("ballpit-{test}-{}", std::process::id()));
+    let d = scratch(test);
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d

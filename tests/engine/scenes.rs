@@ -1,5 +1,6 @@
 //! Presets, placement, CSV round trip, TOML files.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
+use crate::common::cli::scratch;
 use ballpit::physics::sphere::volume;
 use ballpit::scene::csv_io;
 use ballpit::scene::presets::PRESETS;
@@ -137,7 +138,7 @@ fn csv_errors_name_the_line() {
 
 #[test]
 fn toml_scene_files_override_presets_and_list_spheres() {
-    let dir = std::env::temp_dir().join(format!("ballpit-toml-{}", std::process::id()));
+    let dir = scratch("toml");
     std::fs::create_dir_all(&dir).unwrap();
     let a = dir.join("a.toml");
     std::fs::write(&a, "preset = \"billiards\"\ncount = 3\nspeed = 0.25\n").unwrap();

@@ -357,11 +357,7 @@ fn auto_names_the_threads_of_the_model_it_runs() {
 }
 
 fn ballpit(args: &[&str]) -> std::process::Output {
-    assert_cmd::Command::cargo_bin("ballpit")
-        .unwrap()
-        .args(args)
-        .output()
-        .unwrap()
+    crate::common::cli::ballpit().args(args).output().unwrap()
 }
 
 /// `--tolerance` out of [0, 1] is refused with one line and exit 2; with
@@ -454,10 +450,7 @@ fn the_model_row_says_what_auto_runs() {
         );
     })
     .unwrap();
-    let buf = t.backend().buffer();
-    let text: Vec<String> = (0..buf.area.height)
-        .map(|y| (0..buf.area.width).map(|x| buf[(x, y)].symbol()).collect())
-        .collect();
+    let text = crate::common::screen::rows(&t);
     let row = text.iter().find(|r| r.contains("model")).unwrap();
     assert!(row.contains("auto → exact (dense:"), "{text:#?}");
 }

@@ -16,7 +16,7 @@
 //!   bounded by the model (it grows with `dt · speed`, and fast spheres
 //!   tunnel), so only its finiteness is checked.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
-use assert_cmd::Command;
+use crate::common::cli::ballpit;
 use ballpit::physics::exact::Exact;
 use ballpit::physics::{Model, ModelKind, Serial, Sphere, World};
 use ballpit::scene::lattice::lattice_world;
@@ -350,11 +350,7 @@ fn impossible_requests_exit_2() {
         &["bench", "--steps", "1", "--model", "psychic"],
         &["tradeoff", "--radius=-1"],
     ] {
-        let out = Command::cargo_bin("ballpit")
-            .unwrap()
-            .args(args)
-            .output()
-            .unwrap();
+        let out = ballpit().args(args).output().unwrap();
         assert_eq!(out.status.code(), Some(2), "{args:?}");
         // One message (clap adds the allowed values and a line pointing to --help).
         let err = String::from_utf8_lossy(&out.stderr);

@@ -5,6 +5,7 @@
 //! `PROPTEST_CASES=20000 cargo test --release --test physics fuzz_exact::`.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 #![allow(clippy::format_push_string)] // fuzz inputs read best as format strings
+use crate::common::cli::scratch;
 use ballpit::physics::exact::Exact;
 use ballpit::physics::{Model, ModelKind, Serial, Sphere, World};
 use ballpit::scene::{SceneSpec, build_world, csv_io};
@@ -193,7 +194,7 @@ proptest! {
             2 => text += "[[sphere]]\npos = [0.5, 0.5, 0.5]\nvel = [1.0, 0.0, 0.0]\nradius = 0.1\n",
             _ => {}
         }
-        let dir = std::env::temp_dir().join(format!("ballpit-fuzz-{}", std::process::id()));
+        let dir = scratch("fuzz");
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join(format!("s{}.toml", text.len() % 7));
         std::fs::write(&path, &text).unwrap();
