@@ -310,7 +310,7 @@ impl FrameLoop {
                 self.window.physics_frames += 1;
                 self.window.physics_seconds += snap.physics_seconds;
             }
-            self.state.sync(snap, applied);
+            self.state.sync(snap, applied, self.pending);
             self.dirty = true;
         }
         if self.state.running() || self.pending {

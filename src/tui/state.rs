@@ -395,18 +395,22 @@ impl AppState {
 
     /// Take what the engine really did (count and radius may stop at a
     /// limit; reset restores the scene). `applied`: this frame applied our
-    /// commands, so its notice (or the lack of one) answers them.
-    pub fn sync(&mut self, snap: &Snapshot, applied: bool) {
+    /// commands, so its notice (or the lack of one) answers them. `asked_since`:
+    /// keys were pressed after the frame started, so their threading stands
+    /// until a frame answers them.
+    pub fn sync(&mut self, snap: &Snapshot, applied: bool, asked_since: bool) {
         self.count = snap.count;
         if let Some(r) = representative_radius(snap) {
             self.radius = r;
         }
         // The engine's notice (a limit it hit) answers the commands; with
         // none, the key's own notice stays, unless it said work was under way.
-        if applied {
+        if applied && !asked_since {
             // Threads the system refused fall back to what exists.
             self.threading = snap.settings.threading;
             self.threads = snap.settings.threads;
+        }
+        if applied {
             if snap.notice.is_some() {
                 self.notice.clone_from(&snap.notice);
             } else if self.under_way {

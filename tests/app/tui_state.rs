@@ -274,17 +274,37 @@ fn sync_takes_the_real_count_radius_and_the_engine_notice() {
     let mut a = app();
     key(&mut a, Press::Char('N'));
     snap.notice = Some("count limit: no free space".into());
-    a.sync(&snap, true);
+    a.sync(&snap, true, false);
     assert_eq!((a.count, a.radius), (2, 0.1));
     assert_eq!(a.notice.as_deref(), Some("count limit: no free space"));
     // A frame that applied nothing of ours leaves the notice alone.
     snap.notice = None;
-    a.sync(&snap, false);
+    a.sync(&snap, false, false);
     assert!(a.notice.is_some());
     // The next key's frame, with no limit hit, leaves no notice.
     key(&mut a, Press::Char('n'));
-    a.sync(&snap, true);
+    a.sync(&snap, true, false);
     assert!(a.notice.is_none());
+}
+
+/// A frame that lands after more keys were pressed answers the keys before
+/// them: its threading must not undo the later ones (`t` then `d` quickly
+/// cycled from the mode `t` had left), but with no key since, what really
+/// ran (threads the system refused fall back) is taken.
+#[test]
+fn sync_keeps_the_threading_of_keys_pressed_since_the_frame_started() {
+    let mut a = app();
+    let before = a.threading;
+    key(&mut a, Press::Char('t'));
+    assert_ne!(a.threading, before, "t switched the mode");
+    let asked = a.threading;
+    // The landing frame ran the settings from before `t`.
+    let snap = ran().clone();
+    assert_eq!(snap.settings.threading, before);
+    a.sync(&snap, true, true);
+    assert_eq!(a.threading, asked, "a key since the frame started stands");
+    a.sync(&snap, true, false);
+    assert_eq!(a.threading, before, "what ran, once no key is unanswered");
 }
 
 #[test]
@@ -421,10 +441,10 @@ fn a_key_that_does_nothing_yet_keeps_its_notice_through_the_frame() {
     .clone();
     snap.notice = None;
     key(&mut a, Press::Char('P'));
-    a.sync(&snap, true);
+    a.sync(&snap, true, false);
     assert!(a.notice.as_deref().unwrap().contains("kept for pool mode"));
     key(&mut a, Press::Char('0'));
-    a.sync(&snap, true);
+    a.sync(&snap, true, false);
     assert!(a.notice.as_deref().unwrap().contains("back to its start"));
     // Changes of scene are counted, so flat out's comparison starts again.
     let before = a.scene;
@@ -504,7 +524,7 @@ fn sync_shows_auto_s_switch_after_the_key_s_answer_and_takes_what_it_runs() {
     });
     snap.switch_notice = Some("auto: swept → exact (dense)".into());
     // No key of ours: the switch alone.
-    a.sync(&snap, false);
+    a.sync(&snap, false, false);
     assert_eq!(a.notice.as_deref(), Some("auto: swept → exact (dense)"));
     // `exact` ran, on one lane as the engine says, so the pool size does
     // nothing to it: the key says so.
@@ -519,7 +539,7 @@ fn sync_shows_auto_s_switch_after_the_key_s_answer_and_takes_what_it_runs() {
     );
     // A key's answer first, then the switch it caused.
     key(&mut a, Press::Char('>'));
-    a.sync(&snap, true);
+    a.sync(&snap, true, false);
     let n = a.notice.clone().unwrap();
     assert!(
         n.starts_with("tolerance 0.001") && n.ends_with("; auto: swept → exact (dense)"),
@@ -527,7 +547,7 @@ fn sync_shows_auto_s_switch_after_the_key_s_answer_and_takes_what_it_runs() {
     );
     // The frame after: no switch, the notice stays until the next key.
     snap.switch_notice = None;
-    a.sync(&snap, false);
+    a.sync(&snap, false, false);
     assert_eq!(a.notice.as_deref(), Some(n.as_str()));
     // Another model asked: auto's choice no longer speaks for it.
     key(&mut a, Press::Char('m'));
