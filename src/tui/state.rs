@@ -107,7 +107,6 @@ impl AppState {
     /// Do one key; returns what the engine must be told. `ran` is the
     /// latest snapshot: what ran, for the notices that say what a key will
     /// (not) change.
-    #[allow(clippy::too_many_lines)] // one arm a key, as the key table lists them
     pub fn apply(&mut self, action: Action, ran: &Snapshot) -> Vec<Command> {
         self.notice = None;
         self.under_way = false;
