@@ -52,16 +52,30 @@ fn threads_beyond_the_lanes_take_no_cpu() {
     // The scene did run on two lanes, so a pool that woke its other
     // threads had the chance to.
     assert!(parallel > 0.0, "no section ran on two lanes");
-    let second = pool.iter().find(|t| t.0 == 1).map_or(0.0, |t| t.1);
-    assert!(
-        second > 0.1 * total,
-        "pool-1 {second:.3} s of {total:.3} s: the second lane did not run"
-    );
     // Starting 254 threads costs a few milliseconds in all; waking them
     // for each section cost most of the process's CPU (1.68 of 1.74 s).
     assert!(
         beyond < 0.05 * total,
         "the 254 threads without a lane took {beyond:.3} s of {total:.3} s (lanes {lanes:.3} s)"
+    );
+}
+
+/// On an idle host the second lane takes a real share of the work. Timing:
+/// on a loaded host the second lane waits for a core (docs/threading.md),
+/// so this runs with the other timing tests (`--ignored`, retried once).
+#[cfg(target_os = "linux")]
+#[test]
+#[ignore = "timing: needs an idle second core; .ci/run runs it in its timing step (cargo test --release -- --ignored), retried once"]
+fn the_second_lane_shares_the_work_on_an_idle_host() {
+    let (threads, _) = thread_cpu();
+    let total: f64 = threads.iter().map(|t| t.1).sum();
+    let second = threads
+        .iter()
+        .find(|(name, _)| pool_index(name) == Some(1))
+        .map_or(0.0, |t| t.1);
+    assert!(
+        second > 0.1 * total,
+        "pool-1 {second:.3} s of {total:.3} s: the second lane did not run"
     );
 }
 
