@@ -423,6 +423,25 @@ fn empty_and_one_cell_terminals_and_term_dumb_neither_panic_nor_spin() {
     }
 }
 
+/// Paused, the app waits for keys: over two seconds it takes next to no
+/// CPU (the thread panel's sampling and a redraw a second), flat out or not.
+#[test]
+fn a_paused_app_takes_next_to_no_cpu() {
+    for args in [&[][..], &["--tick", "max"][..]] {
+        let mut app = start_with(args, None, (24, 80), "xterm-256color");
+        app.wait_for("the readouts", 10.0, |s| s.contains("steps "));
+        app.send(" ");
+        app.wait_for("paused", 5.0, |s| s.contains("paused"));
+        thread::sleep(Duration::from_millis(300));
+        let (c0, t0) = (app.cpu_seconds(), Instant::now());
+        thread::sleep(Duration::from_secs(2));
+        let load = (app.cpu_seconds() - c0) / t0.elapsed().as_secs_f64();
+        assert!(load < 0.05, "{args:?}: paused, {load:.3} of a core");
+        app.send("q");
+        assert!(app.wait_exit(3.0).expect("q ends the app").success());
+    }
+}
+
 /// The readouts show what ran, so a key must still bring a snapshot while
 /// paused or frozen: the tick and the mode change on screen at once, the
 /// tick is kept through the pause, and tick 0 shows as frozen.
