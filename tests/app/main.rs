@@ -11,6 +11,7 @@ mod help_overlay;
 mod locale_colour;
 mod notices;
 mod readme_keys;
+mod readouts_panel;
 mod slow_link;
 mod terminal_hygiene;
 mod threads_panel;
