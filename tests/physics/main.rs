@@ -8,6 +8,7 @@ mod common;
 
 mod analytic;
 mod auto;
+mod auto_choice;
 mod broad_large;
 mod broad_phase;
 mod clusters;
