@@ -1,6 +1,6 @@
 //! What the screen reads of a finished frame. Two of them exist: the front
 //! one the renderer reads while the physics fills the back one.
-use super::{Settings, physics_threads};
+use super::{Settings, Threading, physics_threads};
 use crate::physics::auto::Choice;
 use crate::physics::broad::Grid;
 use crate::physics::discrete::pair_budget;
@@ -69,6 +69,9 @@ pub struct Snapshot {
     /// event loop): in `pool` the frame is on one pool thread (rayon picks
     /// which), so the pool's size does nothing to it.
     pub one_lane: bool,
+    /// What `physics_threads` was made for: remade only when it changes,
+    /// not every frame (a pool names up to 256 threads).
+    threads_for: Option<(Threading, usize, ModelKind)>,
     /// A limit the last count or radius command hit, e.g. "radius limit:
     /// spheres touch at r = 0.0310"; kept until the next such command.
     pub notice: Option<String>,
@@ -106,6 +109,7 @@ impl Snapshot {
             settings,
             physics_threads: Vec::new(),
             one_lane: false,
+            threads_for: None,
             notice: None,
             pool_busy: None,
         };
@@ -195,6 +199,11 @@ impl Snapshot {
     pub(crate) fn report_threads(&mut self) {
         let s = self.settings;
         let ran = self.model_ran();
+        let key = Some((s.threading, s.threads, ran));
+        if self.threads_for == key {
+            return;
+        }
+        self.threads_for = key;
         self.one_lane = ran.runs_on_one_lane();
         self.physics_threads = physics_threads(s.threading, s.threads, ran);
     }
