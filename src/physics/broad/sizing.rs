@@ -44,15 +44,14 @@ pub(super) fn cell_of_sample(scratch: &mut [f64], max: f64, n: usize, size: f64)
     if scratch.is_empty() {
         return 2.0 * max;
     }
-    let index = |len: usize, share: usize| (len * share / 100).min(len - 1);
-    let k = index(scratch.len(), SHARES[0]);
+    let k = rank(scratch.len(), SHARES[0]);
     let q = *scratch.select_nth_unstable_by(k, f64::total_cmp).1;
-    let mid = index(scratch.len(), 50).min(k);
+    let mid = rank(scratch.len(), 50).min(k);
     let half = *scratch[..=k].select_nth_unstable_by(mid, f64::total_cmp).1;
     // Reaches within a quarter of each other: no share is much narrower,
     // and one level (or two, for the few past `q`) is the least work.
     if q <= NARROW * half {
-        return 2.0 * if max <= 1.25 * q { max } else { q };
+        return 2.0 * widest(q, max);
     }
     // Weighed on at most `WEIGHED` of the sample, in place.
     let stride = scratch.len().div_ceil(WEIGHED);
@@ -63,14 +62,13 @@ pub(super) fn cell_of_sample(scratch: &mut [f64], max: f64, n: usize, size: f64)
     let s = &mut scratch[..len];
     s.sort_unstable_by(f64::total_cmp);
     let s = &*s;
-    let at = |share: usize| s[(s.len() * share / 100).min(s.len() - 1)];
     let (mut best, mut least) = (max, f64::INFINITY);
     for share in SHARES {
-        let q = match at(share) {
-            // When the fastest is close to the bulk, one level holds
-            // everyone.
-            q if share == SHARES[0] && max <= 1.25 * q => max,
-            q => q,
+        let q = s[rank(s.len(), share)];
+        let q = if share == SHARES[0] {
+            widest(q, max)
+        } else {
+            q
         };
         let work = work(s, q, n as f64, size);
         if work < least {
@@ -100,7 +98,7 @@ fn work(s: &[f64], q: f64, n: f64, size: f64) -> f64 {
     if wider.is_empty() {
         return fine;
     }
-    let c2 = 2.0 * wider[(wider.len() * 98 / 100).min(wider.len() - 1)];
+    let c2 = 2.0 * wider[rank(wider.len(), SHARES[0])];
     let coarse = same(n2, c2);
     // Each wider ball looks through the finer level's cells over its reach
     // and the finer level's widest: the cells visited, and the balls in them.
@@ -113,4 +111,15 @@ fn work(s: &[f64], q: f64, n: f64, size: f64) -> f64 {
     }
     let per = n2 / wider.len() as f64;
     fine + coarse + per * (cells + tests)
+}
+
+/// Where the `share` percentile of `len` sorted values is.
+fn rank(len: usize, share: usize) -> usize {
+    (len * share / 100).min(len - 1)
+}
+
+/// The reach a level sized for the 98th percentile `q` takes: the widest
+/// when it is close to the bulk, so one level holds everyone.
+fn widest(q: f64, max: f64) -> f64 {
+    if max <= 1.25 * q { max } else { q }
 }
