@@ -134,10 +134,7 @@ pub fn draw(frame: &mut Frame, raster: &mut Raster, v: &View) {
             report: v.report,
             palette: v.palette,
             by_cpu: v.state.threads_by_cpu,
-            pool: v
-                .snap
-                .pool_busy
-                .map(|b| threads::pool_line(&b, v.snap.count)),
+            pool: threads::pool_line_of(v.snap),
         },
         a.threads,
     );

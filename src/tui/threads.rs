@@ -33,10 +33,26 @@ pub struct Threads<'a> {
     pub pool: Option<String>,
 }
 
+/// The pool line of a frame a pool ran ([`pool_line`]), from what ran.
+pub fn pool_line_of(snap: &crate::engine::Snapshot) -> Option<String> {
+    let serial = snap.one_lane.then(|| snap.model_ran());
+    snap.pool_busy.map(|b| pool_line(&b, snap.count, serial))
+}
+
 /// How many pool threads the scene keeps busy, and why no more, e.g.
 /// `pool: 1 of 64 busy — 1000 spheres too few` (short, to fit the panel).
-pub fn pool_line(b: &crate::physics::exec::Busy, spheres: usize) -> String {
+/// `serial`: the model that ran, when it runs on one lane (`exact`): the
+/// physics then keeps one thread busy, whatever the frame's readouts
+/// spread over the others.
+pub fn pool_line(
+    b: &crate::physics::exec::Busy,
+    spheres: usize,
+    serial: Option<crate::physics::model::ModelKind>,
+) -> String {
     use crate::physics::exec::Bound;
+    if let Some(m) = serial {
+        return format!("pool: 1 of {} busy — {m} is serial", b.threads);
+    }
     let why = match b.bound {
         Bound::Work => format!("{spheres} spheres too few"),
         Bound::Blocks => "too few blocks".into(),
@@ -471,6 +487,7 @@ impl Widget for Threads<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::physics::model::ModelKind;
 
     #[test]
     fn the_pool_line_says_why_only_when_threads_wait() {
@@ -482,7 +499,7 @@ mod tests {
                 threads,
                 bound,
             };
-            pool_line(&b, spheres)
+            pool_line(&b, spheres, None)
         };
         assert_eq!(line(64, 1000), "pool: 1 of 64 busy — 1000 spheres too few");
         // Work for two lanes on two threads: all of them busy.
@@ -493,7 +510,20 @@ mod tests {
             threads: 8,
             bound: Bound::Blocks,
         };
-        assert_eq!(pool_line(&b, 10), "pool: 3 of 8 busy — too few blocks");
+        assert_eq!(
+            pool_line(&b, 10, None),
+            "pool: 3 of 8 busy — too few blocks"
+        );
+        // `exact` runs on one lane: the readouts' lanes are not its busy.
+        let all = Busy {
+            busy: 2,
+            threads: 2,
+            bound: Bound::Threads,
+        };
+        assert_eq!(
+            pool_line(&all, 8000, Some(ModelKind::Exact)),
+            "pool: 1 of 2 busy — exact is serial"
+        );
     }
 
     #[test]

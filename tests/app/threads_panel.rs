@@ -205,3 +205,37 @@ fn s_sorts_the_rows_by_cpu_and_back() {
     st.apply(Action::SortThreads, &ran);
     assert!(!st.threads_by_cpu);
 }
+
+/// A real pool frame of `exact` (8 000 spheres: enough for the frame's
+/// readouts to spread over both lanes): the panel says one thread is busy,
+/// and why, not what the readouts kept busy.
+#[test]
+fn the_pool_line_says_a_serial_model_keeps_one_thread_busy() {
+    use ballpit::engine::{Engine, Settings, Threading};
+    use ballpit::physics::ModelKind;
+    use ballpit::scene::{SceneSpec, build_world};
+    let world = build_world(&SceneSpec {
+        count: Some(8000),
+        ..SceneSpec::default()
+    })
+    .unwrap();
+    for (model, want) in [
+        (ModelKind::Exact, "pool: 1 of 2 busy — exact is serial"),
+        // `swept` shares a step when the work pays for a second lane.
+        (ModelKind::Swept, "pool: 1 of 2 busy — 8000 spheres too few"),
+    ] {
+        let mut e = Engine::new(
+            world.clone(),
+            Settings {
+                model,
+                threading: Threading::Pool,
+                ..settings(2)
+            },
+        )
+        .unwrap();
+        e.start_frame().unwrap();
+        e.finish_frame().unwrap();
+        let line = threads::pool_line_of(e.snapshot());
+        assert_eq!(line.as_deref(), Some(want), "{model}");
+    }
+}
