@@ -85,6 +85,20 @@ fn frame(t: &mut Term, raster: &mut Raster, view: &View) {
     queue!(t.backend_mut(), EndSynchronizedUpdate).unwrap();
 }
 
+/// [`frame`] of `snap` in state `st`, with empty statistics and CPU report.
+fn frame_of(t: &mut Term, raster: &mut Raster, st: &AppState, snap: &Snapshot) {
+    let (stats, report) = (Stats::default(), CpuReport::default());
+    let view = View {
+        state: st,
+        snap,
+        stats: &stats,
+        report: &report,
+        palette: Palette::C16,
+        aspect: 2.0,
+    };
+    frame(t, raster, &view);
+}
+
 /// Snapshots of `frames` consecutive frames.
 fn frames(world: World, frames: usize) -> Vec<Snapshot> {
     let mut e = Engine::new(world, settings()).unwrap();
@@ -99,34 +113,33 @@ fn frames(world: World, frames: usize) -> Vec<Snapshot> {
 /// Time building whole frames at 200×60, alternating two snapshots so every
 /// frame has changes to send.
 fn bench_view(c: &mut Criterion, id: &str, st: &AppState, snaps: &[Snapshot]) {
-    let (stats, report) = (Stats::default(), CpuReport::default());
     let (mut t, _) = terminal(200, 60);
     let mut raster = Raster::new();
     let mut k = 0;
     c.bench_function(id, |b| {
         b.iter(|| {
             k += 1;
-            let view = View {
-                state: st,
-                snap: &snaps[k % 2],
-                stats: &stats,
-                report: &report,
-                palette: Palette::C16,
-                aspect: 2.0,
-            };
-            frame(&mut t, &mut raster, &view);
+            frame_of(&mut t, &mut raster, st, &snaps[k % 2]);
         });
     });
 }
 
-fn bench_frame(c: &mut Criterion) {
-    let snaps = frames(lattice_world(10_000, 0.01, 0.5, 7), 2);
-    for (name, style) in [
+/// The app state of the 10k lattice in each drawing style, by name.
+fn styles_at_10k() -> [(&'static str, AppState); 2] {
+    [
         ("braille", DrawStyle::PointsSpeed),
         ("shaded", DrawStyle::Shaded),
-    ] {
+    ]
+    .map(|(name, style)| {
         let mut st = AppState::new(&settings(), 10_000, 0.01, 30.0);
         st.style = style;
+        (name, st)
+    })
+}
+
+fn bench_frame(c: &mut Criterion) {
+    let snaps = frames(lattice_world(10_000, 0.01, 0.5, 7), 2);
+    for (name, st) in styles_at_10k() {
         bench_view(c, &format!("frame/10k_spheres_200x60_{name}"), &st, &snaps);
     }
     // 100 000 spheres still draw (as points).
@@ -198,27 +211,11 @@ fn schedstat() -> Option<(u64, u64)> {
 
 fn frame_cpu() {
     let snaps = frames(lattice_world(10_000, 0.01, 0.5, 7), 2);
-    for (name, style) in [
-        ("braille", DrawStyle::PointsSpeed),
-        ("shaded", DrawStyle::Shaded),
-    ] {
-        let mut st = AppState::new(&settings(), 10_000, 0.01, 30.0);
-        st.style = style;
-        let (stats, report) = (Stats::default(), CpuReport::default());
+    for (name, st) in styles_at_10k() {
         let (mut t, _) = terminal(200, 60);
         let mut raster = Raster::new();
         let n = 400;
-        let mut run = |k: usize| {
-            let view = View {
-                state: &st,
-                snap: &snaps[k % 2],
-                stats: &stats,
-                report: &report,
-                palette: Palette::C16,
-                aspect: 2.0,
-            };
-            frame(&mut t, &mut raster, &view);
-        };
+        let mut run = |k: usize| frame_of(&mut t, &mut raster, &st, &snaps[k % 2]);
         for k in 0..20 {
             run(k);
         }

@@ -40,12 +40,7 @@ fn report(pool: usize) -> CpuReport {
             }
         })
         .collect();
-    CpuReport {
-        total_percent: threads.iter().map(|t| t.percent).sum(),
-        threads,
-        cores: 2,
-        others_percent: Some(50.0),
-    }
+    CpuReport::new(threads, 2, Some(50.0))
 }
 
 /// On-CPU nanoseconds of this thread so far.

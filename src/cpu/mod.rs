@@ -44,6 +44,18 @@ pub struct CpuReport {
     pub others_percent: Option<f64>,
 }
 
+impl CpuReport {
+    /// The report of `threads`, their total the process's.
+    pub fn new(threads: Vec<ThreadLoad>, cores: usize, others_percent: Option<f64>) -> Self {
+        CpuReport {
+            total_percent: threads.iter().map(|t| t.percent).sum(),
+            threads,
+            cores,
+            others_percent,
+        }
+    }
+}
+
 /// How long the load is averaged over.
 pub const WINDOW: Duration = Duration::from_secs(1);
 
@@ -146,12 +158,7 @@ impl Sampler {
             })
             .collect();
         threads.sort_by(|a, b| order_key(a).cmp(&order_key(b)));
-        self.report = CpuReport {
-            total_percent: threads.iter().map(|t| t.percent).sum(),
-            threads,
-            cores: self.cores,
-            others_percent: self.others.sample(),
-        };
+        self.report = CpuReport::new(threads, self.cores, self.others.sample());
         &self.report
     }
 

@@ -238,12 +238,7 @@ fn report(mode: Threading, pool: usize) -> CpuReport {
             history: vec![1.0 + (i % 7) as f64; 60],
         })
         .collect();
-    CpuReport {
-        total_percent: threads.iter().map(|t| t.percent).sum(),
-        threads,
-        cores: 2,
-        others_percent: Some(12.5),
-    }
+    CpuReport::new(threads, 2, Some(12.5))
 }
 
 /// What the screen shows in the notice's style, row by row, and whether

@@ -45,12 +45,7 @@ fn report(pool: usize) -> CpuReport {
     add(5003, "output".into(), 0.4);
     add(5004, "input".into(), 0.1);
     threads.sort_by_key(|t| t.tid);
-    CpuReport {
-        total_percent: threads.iter().map(|t| t.percent).sum(),
-        threads,
-        cores: 2,
-        others_percent: Some(37.5),
-    }
+    CpuReport::new(threads, 2, Some(37.5))
 }
 
 #[test]

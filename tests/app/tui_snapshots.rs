@@ -108,12 +108,7 @@ pub(crate) fn report_for(mode: Threading, pool: usize) -> CpuReport {
             }
         })
         .collect();
-    CpuReport {
-        total_percent: threads.iter().map(|t| t.percent).sum(),
-        threads,
-        cores: 2,
-        others_percent: Some(37.5),
-    }
+    CpuReport::new(threads, 2, Some(37.5))
 }
 
 pub(crate) fn state() -> AppState {

@@ -67,33 +67,21 @@ fn the_reference_takes_known_contacts_and_keeps_the_invariants() {
             Sphere::new(DVec3::new(0.75, 0.5, 0.5), DVec3::new(-1.0, 0.0, 0.0), 0.1),
         ],
     );
+    // A coordinate of a position or velocity is `want`, to `tol`.
+    let at = |got: f64, want: f64, tol: f64, w: &World| {
+        assert!((got - want).abs() < tol, "{got} != {want}: {:?}", w.spheres);
+    };
     reference::run(&mut w, 0.2);
     assert_eq!(w.counters.sphere_collisions, 1);
     assert_eq!(w.counters.wall_collisions, 0);
-    assert!(
-        (w.spheres[0].vel.x + 1.0).abs() < 1e-15,
-        "{:?}",
-        w.spheres[0]
-    );
-    assert!(
-        (w.spheres[0].pos.x - 0.35).abs() < 1e-14,
-        "{:?}",
-        w.spheres[0]
-    );
+    at(w.spheres[0].vel.x, -1.0, 1e-15, &w);
+    at(w.spheres[0].pos.x, 0.35, 1e-14, &w);
     // Sphere 0 reaches x = 0.1 at t = 0.45 and is back at 0.15 at t = 0.5;
     // sphere 1 mirrors it.
     reference::run(&mut w, 0.3);
     assert_eq!(w.counters.wall_collisions, 2);
-    assert!(
-        (w.spheres[0].pos.x - 0.15).abs() < 1e-14,
-        "{:?}",
-        w.spheres[0]
-    );
-    assert!(
-        (w.spheres[1].pos.x - 0.85).abs() < 1e-14,
-        "{:?}",
-        w.spheres[1]
-    );
+    at(w.spheres[0].pos.x, 0.15, 1e-14, &w);
+    at(w.spheres[1].pos.x, 0.85, 1e-14, &w);
     assert!((w.time - 0.5).abs() < 1e-15);
     // Momentum to the walls: 2 m |v| per hit.
     let m = w.spheres[0].mass;
