@@ -7,7 +7,7 @@ pub mod error;
 pub mod memory;
 pub mod physics;
 pub(crate) mod procfs;
-pub mod progress;
+mod progress;
 pub mod scaling;
 pub mod scene;
 pub mod tradeoff;

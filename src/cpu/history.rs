@@ -58,12 +58,9 @@ impl History {
         self.values.iter().copied().collect()
     }
 
+    #[cfg(test)]
     pub fn len(&self) -> usize {
         self.values.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.values.is_empty()
     }
 }
 

@@ -2,8 +2,8 @@
 //! (`/proc/self/task/*/schedstat`, nanosecond run time, falling back to the
 //! clock ticks of `stat`), by thread name from `comm`, and what other
 //! processes take (`machine`). Elsewhere the report holds only the core count.
-pub mod history;
-pub mod machine;
+pub(crate) mod history;
+mod machine;
 mod role;
 mod task;
 

@@ -13,7 +13,7 @@
 //! the `off` run's time: the share of one thread's work that did not
 //! spread), and the Karp–Flatt fraction of its speed-up. One Amdahl fit of
 //! the pool's speed-ups then predicts 16, 64 and 128 cores.
-pub mod fit;
+mod fit;
 mod report;
 
 pub use report::{CSV_COLUMNS, csv, markdown, svg};
@@ -121,7 +121,7 @@ pub struct Sweep {
 }
 
 impl Sweep {
-    /// Predicted speed-ups at [`fit::PREDICT_AT`] cores from the fit.
+    /// Predicted speed-ups at `fit::PREDICT_AT` cores from the fit.
     #[must_use]
     pub fn predictions(&self) -> Vec<(usize, f64)> {
         self.fitted.map_or_else(Vec::new, |f| {

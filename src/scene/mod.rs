@@ -1,9 +1,9 @@
 //! Scenes: the presets, TOML scene files and sphere CSVs, turned into a
 //! checked [`World`].
-pub mod bounded;
+mod bounded;
 pub mod csv_io;
 pub mod lattice;
-pub mod place;
+mod place;
 pub mod presets;
 pub mod toml_file;
 

@@ -104,6 +104,7 @@ impl Latch {
     }
 
     /// Status requests not answered yet.
+    #[cfg(test)]
     pub fn owed(&self) -> u64 {
         *self.owed.lock()
     }

@@ -112,6 +112,7 @@ impl Pacer {
         p
     }
 
+    #[cfg(test)]
     pub fn mode(&self) -> Mode {
         self.mode
     }

@@ -3,7 +3,7 @@
 //! frame asks for positions), its collision count and its species. One
 //! cache line, so checking a neighbour, and whether a prediction about it
 //! still holds, costs one line; radii and masses live in the small
-//! [`SpeciesTable`].
+//! `SpeciesTable`.
 use super::ids::{Label, SpeciesId};
 use super::species::{Species, SpeciesTable};
 use crate::physics::sphere::Sphere;

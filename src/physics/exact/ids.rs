@@ -4,9 +4,26 @@
 //! [`WorldId`] of the sphere it is in `world.spheres`, a [`SpeciesId`] and
 //! a neighbour-list grid [`Cell`]. Each is 4 bytes, as the plain `u32`s were.
 
-/// Defines a 4-byte index type: `at`/`index` to and from `usize`, `raw` and
-/// `from_raw` where the number sits in a packed word.
+/// Defines a 4-byte index type: `at`/`index` to and from `usize`, and for a
+/// `packed` one `raw` and `from_raw` where the number sits in a packed word.
 macro_rules! index_type {
+    ($(#[$doc:meta])* $name:ident, packed) => {
+        index_type!($(#[$doc])* $name);
+
+        impl $name {
+            /// From the word a packed record keeps it in.
+            #[inline(always)]
+            pub fn from_raw(raw: u32) -> Self {
+                Self(raw)
+            }
+
+            /// The word to keep it in a packed record.
+            #[inline(always)]
+            pub fn raw(self) -> u32 {
+                self.0
+            }
+        }
+    };
     ($(#[$doc:meta])* $name:ident) => {
         $(#[$doc])*
         #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -24,18 +41,6 @@ macro_rules! index_type {
             pub fn index(self) -> usize {
                 self.0 as usize
             }
-
-            /// From the word a packed record keeps it in.
-            #[inline(always)]
-            pub fn from_raw(raw: u32) -> Self {
-                Self(raw)
-            }
-
-            /// The word to keep it in a packed record.
-            #[inline(always)]
-            pub fn raw(self) -> u32 {
-                self.0
-            }
         }
     };
 }
@@ -43,7 +48,7 @@ macro_rules! index_type {
 index_type!(
     /// A body's place in the model's own order (sorted in space at load,
     /// and again as the spheres drift if renumbering is on): never a world id.
-    Label
+    Label, packed
 );
 
 index_type!(
@@ -54,7 +59,7 @@ index_type!(
 
 index_type!(
     /// A radius–mass pair's place in the model's species table.
-    SpeciesId
+    SpeciesId, packed
 );
 
 index_type!(

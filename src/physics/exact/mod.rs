@@ -10,12 +10,12 @@
 //! - a broad phase chosen by packing fraction ([`LISTS_ABOVE_PACKING`]):
 //!   a cell grid with cell-crossing events for dilute and moderate scenes
 //!   ([`cell_grid`]), neighbour lists with a skin for dense ones
-//!   ([`neighbour_lists`]); both keep the few spheres far larger than the
-//!   bulk on a second level ([`large`]), so radii 100x apart stay cheap;
+//!   (`neighbour_lists`); both keep the few spheres far larger than the
+//!   bulk on a second level (`large`), so radii 100x apart stay cheap;
 //! - stale predictions detected by per-sphere collision counts ([`schedule`]);
-//! - spheres sorted in space at load ([`spatial`]; relabelling them again
+//! - spheres sorted in space at load (`spatial`; relabelling them again
 //!   as they drift, `renumber`, is an experiment); the world keeps every
-//!   sphere at its id ([`ids`]: labels and world ids are apart).
+//!   sphere at its id (`ids`: labels and world ids are apart).
 //!
 //! Time of impact comes from [`pair_toi`](crate::physics::contact::pair_toi)
 //! (stable quadratic, rounding guard: overlapping and approaching collides
@@ -44,20 +44,20 @@
 //! the schedule is rebuilt for the next step.
 pub mod body;
 #[cfg(feature = "experiments")]
-pub mod calendar;
+mod calendar;
 pub mod cell_grid;
 #[cfg(feature = "experiments")]
 mod hooks;
-pub mod ids;
-pub mod large;
-pub mod neighbour_lists;
+mod ids;
+mod large;
+mod neighbour_lists;
 mod overlap;
-pub mod queue;
+mod queue;
 #[cfg(feature = "experiments")]
-pub mod renumber;
+mod renumber;
 pub mod schedule;
-pub mod spatial;
-pub mod species;
+mod spatial;
+mod species;
 
 use super::contact::{reflect_walls, resolve_pair};
 use super::exec::Exec;

@@ -53,12 +53,9 @@ impl SpeciesTable {
         self.list[k.index()]
     }
 
+    #[cfg(test)]
     pub fn len(&self) -> usize {
         self.list.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.list.is_empty()
     }
 
     /// Bytes held on the heap.

@@ -91,6 +91,7 @@ impl CellBlocks {
     }
 
     /// Spheres in cell `c`.
+    #[cfg(test)]
     #[inline]
     pub fn count(&self, c: usize) -> u32 {
         let (_, one, b) = self.parts(self.slot[c]);

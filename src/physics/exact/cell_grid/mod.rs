@@ -3,7 +3,7 @@
 //! bulk diameter, so spheres can only touch from neighbouring cells; a
 //! sphere's candidates are the spheres in the 27 cells around its own. A
 //! sphere changes cell only at a crossing event, so the pair bookkeeping is
-//! one move between cells ([`CellBlocks`]), and crossings are rarer than
+//! one move between cells (`CellBlocks`), and crossings are rarer than
 //! neighbour-list rebuilds when the mean free path is long.
 //!
 //! Large spheres (the few far above the bulk radius) stay out of the grid:
@@ -11,7 +11,7 @@
 //! the cells over its own reach plus a skin, rescanning when it has moved
 //! the skin (a small sphere entering that reach does so by a crossing, which
 //! checks the large ones).
-pub mod blocks;
+mod blocks;
 
 use super::body::{Bodies, Body};
 use super::ids::Label;
@@ -267,7 +267,7 @@ impl CellGrid {
 
     /// Every sphere that sphere `i` could touch before its next broad-phase
     /// event, into `out[..n]` (returns `n`; sphere `i` itself may be among
-    /// them), as [`Label::raw`]s: the 27 cells around a small one, the cells
+    /// them), as `Label::raw`s: the 27 cells around a small one, the cells
     /// over a large one's reach (its `radius` plus the bulk's and a skin)
     /// from its scan centre; and every large sphere.
     #[inline]

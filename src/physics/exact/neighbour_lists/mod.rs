@@ -14,7 +14,7 @@
 //! few much larger spheres live on a second level — every small sphere checks
 //! them when it rebuilds, and a large one scans the grid cells over its own
 //! reach.
-pub mod chains;
+mod chains;
 
 use super::body::{Bodies, Body};
 use super::ids::{Cell, Label};
