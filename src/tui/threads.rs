@@ -47,7 +47,7 @@ pub fn pool_line_of(snap: &crate::engine::Snapshot) -> Option<String> {
 pub fn pool_line(
     b: &crate::physics::exec::Busy,
     spheres: usize,
-    serial: Option<crate::physics::model::ModelKind>,
+    serial: Option<crate::physics::ModelKind>,
 ) -> String {
     use crate::physics::exec::Bound;
     if let Some(m) = serial {
@@ -487,7 +487,7 @@ impl Widget for Threads<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::physics::model::ModelKind;
+    use crate::physics::ModelKind;
 
     #[test]
     fn the_pool_line_says_why_only_when_threads_wait() {
