@@ -38,6 +38,11 @@ pub struct BenchReport {
     /// sleep between frames, up to the last scheduler tick for the caller
     /// in `off`.
     pub physics_cpu_seconds: f64,
+    /// The first frame alone, which also loads the spheres into the model
+    /// and builds its structures: a run's steady rate leaves it out,
+    /// `(sphere_collisions - first_frame.sphere_collisions) /
+    /// (physics_cpu_seconds - first_frame.physics_cpu_seconds)`.
+    pub first_frame: FirstFrame,
     /// In `pool`: the part of `wall_seconds` spent inside sections that ran
     /// on more than one lane; the rest is the step's serial part (null in
     /// the other modes).
@@ -70,6 +75,13 @@ pub struct BenchReport {
     /// Where the run could not keep a model's promise, and why (empty when
     /// it kept them all).
     pub warnings: Vec<String>,
+}
+
+/// The first frame's share of a run (see [`BenchReport::first_frame`]).
+#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
+pub struct FirstFrame {
+    pub physics_cpu_seconds: f64,
+    pub sphere_collisions: u64,
 }
 
 /// What a reader of `report` must know before trusting its figures: the
@@ -137,7 +149,15 @@ pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(Ben
         .map(|tid| (tid, crate::cpu::thread_cpu_seconds_of(tid).unwrap_or(0.0)))
         .collect();
     let parallel_before = engine.parallel_seconds().unwrap_or(0.0);
-    let (wall, max_err) = step_frames(&mut engine, steps, frame, &|e| energy_change(e, e0))?;
+    let mut first_frame = FirstFrame::default();
+    let mut after_first = |e: &Engine| {
+        first_frame = FirstFrame {
+            physics_cpu_seconds: physics_cpu(e, &e.physics_threads(), &cpu_before),
+            sphere_collisions: e.snapshot().counters.sphere_collisions,
+        };
+    };
+    let rel = |e| energy_change(e, e0);
+    let (wall, max_err) = step_frames(&mut engine, steps, frame, &rel, &mut after_first)?;
     let physics_threads = engine.physics_threads();
     let measured = Measured {
         wall,
@@ -145,6 +165,7 @@ pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(Ben
         parallel_seconds: (settings.threading == crate::engine::Threading::Pool)
             .then(|| engine.parallel_seconds().unwrap_or(0.0) - parallel_before),
         physics_cpu_seconds: physics_cpu(&engine, &physics_threads, &cpu_before),
+        first_frame,
         physics_threads,
         load_average: load_start.into_iter().chain(load_average()).collect(),
         // Read while the engine's threads are still alive.
@@ -185,6 +206,7 @@ struct Measured {
     max_err: f64,
     parallel_seconds: Option<f64>,
     physics_cpu_seconds: f64,
+    first_frame: FirstFrame,
     physics_threads: Vec<String>,
     load_average: Vec<f64>,
     thread_cpu: Vec<ThreadCpu>,
@@ -220,6 +242,7 @@ fn report_of(
         physics_threads: m.physics_threads,
         wall_seconds: m.wall,
         physics_cpu_seconds: m.physics_cpu_seconds,
+        first_frame: m.first_frame,
         parallel_seconds: m.parallel_seconds,
         load_average: m.load_average,
         steps_per_second: per_sec(steps as f64),
@@ -249,12 +272,14 @@ fn report_of(
 }
 
 /// Run `steps` steps in frames of `frame` steps (the last one shorter):
-/// the physics seconds they took and the worst energy error `rel` gave.
+/// the physics seconds they took and the worst energy error `rel` gave;
+/// `after_first` reads the engine once the first frame is done.
 fn step_frames(
     engine: &mut Engine,
     steps: u64,
     frame: u64,
     rel: &dyn Fn(f64) -> f64,
+    after_first: &mut dyn FnMut(&Engine),
 ) -> anyhow::Result<(f64, f64)> {
     let (mut wall, mut max_err, mut done) = (0.0, 0.0f64, 0);
     while done < steps {
@@ -266,6 +291,9 @@ fn step_frames(
         let snap = engine.finish_frame()?;
         wall += snap.physics_seconds;
         max_err = max_err.max(rel(snap.energy));
+        if done == 0 {
+            after_first(engine);
+        }
         done += now;
     }
     Ok((wall, max_err))

@@ -35,6 +35,10 @@ pub const BENCH_FIELDS: &[(&str, &str)] = &[
         "CPU time of the physics_threads while stepping",
     ),
     (
+        "first_frame",
+        "{physics_cpu_seconds, sphere_collisions} of the first frame, which also loads the model: leave it out for a steady rate",
+    ),
+    (
         "parallel_seconds",
         "pool only: the part of wall_seconds in sections on more than one lane (null otherwise)",
     ),

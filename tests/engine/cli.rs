@@ -15,6 +15,7 @@ fn bench_prints_one_json_line_with_every_field() {
         "threads",
         "wall_seconds",
         "physics_cpu_seconds",
+        "first_frame",
         "load_average",
         "collisions_per_sim_second",
         "steps_per_second",
@@ -41,6 +42,27 @@ fn bench_prints_one_json_line_with_every_field() {
     assert!(v["energy_drift_rel"].as_f64().unwrap() < 1e-12);
     assert!(v["peak_rss_bytes"].as_u64().unwrap() > 0);
     assert_eq!(v["load_average"].as_array().unwrap().len(), 2);
+}
+
+/// The first frame is reported apart (it also loads the model), so a
+/// steady rate can leave it out: it is exactly a one-frame run.
+#[test]
+fn bench_reports_the_first_frame_apart() {
+    let args = |steps| {
+        let base = ["--model", "exact", "--count", "2000", "--radius", "0.02"];
+        let run = ["--threading", "worker", "--tick", "1", "--steps", steps];
+        json::bench(&[&base[..], &run[..]].concat())
+    };
+    let (one, many) = (args("1"), args("20"));
+    let first = &many["first_frame"];
+    assert_eq!(first["sphere_collisions"], one["sphere_collisions"]);
+    assert!(one["sphere_collisions"].as_u64().unwrap() > 0);
+    let (f, all) = (
+        first["physics_cpu_seconds"].as_f64().unwrap(),
+        many["physics_cpu_seconds"].as_f64().unwrap(),
+    );
+    assert!(f > 0.0 && f < all, "first frame {f} s of {all} s");
+    assert!(many["sphere_collisions"].as_u64() > first["sphere_collisions"].as_u64());
 }
 
 #[test]
@@ -396,11 +418,24 @@ fn bench_help_names_exactly_the_fields_the_json_has() {
     // Keep the printed order: a JSON object's keys in the line as written.
     let line = json::bench_line(&["--steps", "2", "--count", "20"]);
     let v: serde_json::Value = serde_json::from_str(&line).unwrap();
+    // Where each top-level key is written: its first place at depth 1 (a
+    // nested object may use the same name).
+    let depth: Vec<i32> = line
+        .bytes()
+        .scan(0, |d, b| {
+            *d += i32::from(b == b'{') - i32::from(b == b'}');
+            Some(*d)
+        })
+        .collect();
+    let at = |k: &str| {
+        let pat = format!("\"{k}\":");
+        line.match_indices(&pat).find(|(i, _)| depth[*i] == 1).unwrap().0
+    };
     let mut keys: Vec<(usize, &str)> = v
         .as_object()
         .unwrap()
         .keys()
-        .map(|k| (line.find(&format!("\"{k}\":")).unwrap(), k.as_str()))
+        .map(|k| (at(k), k.as_str()))
         .collect();
     keys.sort_unstable();
     let printed: Vec<&str> = keys.into_iter().map(|(_, k)| k).collect();
