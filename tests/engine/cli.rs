@@ -429,7 +429,10 @@ fn bench_help_names_exactly_the_fields_the_json_has() {
         .collect();
     let at = |k: &str| {
         let pat = format!("\"{k}\":");
-        line.match_indices(&pat).find(|(i, _)| depth[*i] == 1).unwrap().0
+        line.match_indices(&pat)
+            .find(|(i, _)| depth[*i] == 1)
+            .unwrap()
+            .0
     };
     let mut keys: Vec<(usize, &str)> = v
         .as_object()
