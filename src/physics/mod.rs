@@ -11,6 +11,7 @@ pub mod exact;
 pub mod exec;
 pub mod flight;
 pub(crate) mod free_space;
+pub(crate) mod huge_pages;
 mod kind;
 mod model;
 pub mod reference;

@@ -6,6 +6,7 @@
 //! `SpeciesTable`.
 use super::ids::{Label, SpeciesId};
 use super::species::{Species, SpeciesTable};
+use crate::physics::huge_pages;
 use crate::physics::sphere::Sphere;
 use glam::DVec3;
 use std::ops::{Deref, DerefMut, Index, IndexMut};
@@ -49,15 +50,15 @@ impl Bodies {
     /// The spheres, in this order, at time stamp `t`, every count zero.
     pub fn from_spheres<'a>(spheres: impl Iterator<Item = &'a Sphere>, t: f64) -> Self {
         let mut species = SpeciesTable::default();
-        let list = spheres
-            .map(|s| Body {
-                pos: s.pos,
-                vel: s.vel,
-                t,
-                count: 0,
-                species: species.name(s.radius, s.mass),
-            })
-            .collect();
+        let mut list = Vec::new();
+        huge_pages::reserve(&mut list, spheres.size_hint().0);
+        list.extend(spheres.map(|s| Body {
+            pos: s.pos,
+            vel: s.vel,
+            t,
+            count: 0,
+            species: species.name(s.radius, s.mass),
+        }));
         species.seal();
         Bodies { list, species }
     }

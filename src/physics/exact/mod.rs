@@ -237,6 +237,7 @@ impl<Q: EventQueue> EventDriven<Q> {
             b.count = 0;
         }
         self.slots.clear();
+        super::huge_pages::reserve(&mut self.slots, n);
         self.slots.resize(n, Slot::default());
         // The old broad phase goes first, so a rebuild never holds two.
         self.broad = Broad::default();

@@ -7,6 +7,8 @@
 //! O(1) with no allocation and no stale entries, which a binary heap of all
 //! predictions would accumulate.
 
+use crate::physics::huge_pages;
+
 /// The earliest of one pending event time per sphere. Simultaneous events
 /// pop in sphere-index order (lower index first): the fixed order that makes
 /// runs reproducible, so another queue must keep it to give the same runs:
@@ -123,8 +125,10 @@ impl EventQueue for Tournament {
     fn reset(&mut self, n: usize) {
         self.size = n.next_power_of_two().max(1);
         self.keys.clear();
+        huge_pages::reserve(&mut self.keys, 2 * self.size);
         self.keys.resize(2 * self.size, key(f64::INFINITY));
         self.ids.clear();
+        huge_pages::reserve(&mut self.ids, self.size.max(2));
         self.ids.resize(self.size.max(2), 0);
         self.rebuild();
     }

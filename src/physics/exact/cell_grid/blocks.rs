@@ -12,6 +12,7 @@
 //! empty one unless the cell has its own). The rare spheres beyond
 //! [`BLOCK`] in one cell wait in a map from the cell.
 use crate::physics::exact::ids::Label;
+use crate::physics::huge_pages;
 use std::collections::HashMap;
 
 /// Spheres a cell's block holds (cells are about a diameter wide, so most
@@ -48,8 +49,9 @@ impl CellBlocks {
     /// `spheres` can fill two at a time (reserved, not touched: the pool
     /// never needs more, so it never moves).
     pub fn reset(&mut self, spheres: usize, cells: usize) {
-        self.slot = vec![EMPTY; cells];
-        self.pool = Vec::with_capacity((spheres / 2).min(cells) + 1);
+        self.slot = huge_pages::filled(cells, EMPTY);
+        self.pool = Vec::new();
+        huge_pages::reserve(&mut self.pool, (spheres / 2).min(cells) + 1);
         self.pool.push([0; WORDS]);
         self.free = NO_BLOCK;
         self.overflow.clear();

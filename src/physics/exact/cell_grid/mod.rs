@@ -19,6 +19,7 @@ use super::large::{BIG_FACTOR, split_big, time_to_leave};
 #[cfg(feature = "experiments")]
 use super::renumber::apply;
 use super::schedule::{Event, Kind};
+use crate::physics::huge_pages;
 use blocks::CellBlocks;
 use glam::DVec3;
 
@@ -89,6 +90,7 @@ impl CellGrid {
         let n = bodies.len();
         self.list.reset(0, 0);
         self.place.clear();
+        huge_pages::reserve(&mut self.place, n);
         self.place.resize(n, BIG);
         self.bigs.clear();
         self.scan_centre.clear();

@@ -6,6 +6,7 @@
 use crate::physics::exact::ids::{Cell, Label};
 #[cfg(feature = "experiments")]
 use crate::physics::exact::renumber::apply;
+use crate::physics::huge_pages;
 
 #[derive(Clone, Debug, Default)]
 pub struct CellChains {
@@ -23,11 +24,14 @@ impl CellChains {
     pub fn reset(&mut self, spheres: usize, cells: usize) {
         for v in [&mut self.next, &mut self.prev] {
             v.clear();
+            huge_pages::reserve(v, spheres);
             v.resize(spheres, Label::NONE);
         }
         self.cell.clear();
+        huge_pages::reserve(&mut self.cell, spheres);
         self.cell.resize(spheres, Cell::NONE);
         self.head.clear();
+        huge_pages::reserve(&mut self.head, cells);
         self.head.resize(cells, Label::NONE);
     }
 

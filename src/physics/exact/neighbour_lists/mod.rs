@@ -21,6 +21,7 @@ use super::ids::{Cell, Label};
 use super::large::{BIG_FACTOR, split_big, time_to_leave};
 #[cfg(feature = "experiments")]
 use super::renumber::{apply, apply_chunks};
+use crate::physics::huge_pages;
 use chains::CellChains;
 use glam::DVec3;
 
@@ -77,10 +78,13 @@ impl Lists {
     fn reset(&mut self, n: usize) {
         self.stride = 32;
         self.flat.clear();
+        huge_pages::reserve(&mut self.flat, n * self.stride);
         self.flat.resize(n * self.stride, Link::default());
         self.len.clear();
+        huge_pages::reserve(&mut self.len, n);
         self.len.resize(n, 0);
         self.home.clear();
+        huge_pages::reserve(&mut self.home, n);
         self.home.resize(n, Home::FLAT);
         self.big.clear();
     }
@@ -190,7 +194,7 @@ impl Lists {
     fn grow(&mut self) {
         let old = self.stride;
         self.stride *= 2;
-        let mut flat = vec![Link::default(); self.len.len() * self.stride];
+        let mut flat = huge_pages::filled(self.len.len() * self.stride, Link::default());
         for (i, &l) in self.len.iter().enumerate() {
             let l = l as usize;
             flat[i * self.stride..i * self.stride + l]
@@ -232,6 +236,7 @@ impl NeighbourLists {
     pub fn build(&mut self, bodies: &Bodies, size: f64) {
         let n = bodies.len();
         self.centre.clear();
+        huge_pages::reserve(&mut self.centre, n);
         self.centre.extend(bodies.iter().map(|b| Centre {
             pos: b.pos,
             radius: bodies.radius_of(b),

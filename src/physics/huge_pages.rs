@@ -1,0 +1,114 @@
+//! Transparent huge pages for the arrays that hold a value per sphere and
+//! are read in no order: `exact`'s bodies, event slots and queue, its cells
+//! and neighbour lists.
+//!
+//! At a million spheres those arrays span hundreds of megabytes, and with
+//! 4 KB pages nearly every read an event makes also misses the TLB. Many
+//! kernels (Debian's and Ubuntu's among them) back memory with 2 MB pages
+//! only where the program asks (`/sys/kernel/mm/transparent_hugepage/enabled`
+//! set to `madvise`), and the allocator does not ask. Asking for them made
+//! `exact`'s steady rate 5–16 % higher at 1M spheres, and changed nothing
+//! at 10k, where no array is that large (docs/perf-log.md, 2026-12-05).
+//!
+//! The one `unsafe` call of the crate is here (the crate denies it
+//! everywhere else): `madvise` takes a raw address, though this advice
+//! never changes what the memory holds or who may touch it.
+#![allow(unsafe_code)]
+
+/// Arrays from this size up are advised: one huge page on x86-64 and on
+/// most arm64 kernels. Smaller ones could not use a huge page anyway.
+const HUGE_PAGE: usize = 2 << 20;
+
+/// Room for `n` values in `v`, in memory the kernel may back with huge
+/// pages when it is that large. Call it before the values are written:
+/// pages written first after it are huge from their first touch.
+pub fn reserve<T>(v: &mut Vec<T>, n: usize) {
+    v.reserve(n.saturating_sub(v.len()));
+    advise(v);
+}
+
+/// A vector of `n` copies of `value`, in huge pages when it is large.
+pub fn filled<T: Clone>(n: usize, value: T) -> Vec<T> {
+    let mut v = Vec::new();
+    reserve(&mut v, n);
+    v.resize(n, value);
+    v
+}
+
+/// Ask for huge pages for the whole of `v`'s buffer.
+#[cfg(target_os = "linux")]
+fn advise<T>(v: &mut Vec<T>) {
+    let bytes = v.capacity() * size_of::<T>();
+    if bytes < HUGE_PAGE {
+        return;
+    }
+    let page = rustix::param::page_size();
+    let start = v.as_mut_ptr().cast::<u8>();
+    // madvise wants a page-aligned start: the buffer's first page.
+    let back = start.addr() % page;
+    let first = start.wrapping_sub(back).cast::<std::ffi::c_void>();
+    // SAFETY: MADV_HUGEPAGE only changes how the kernel backs the pages of
+    // the range with physical memory; their contents and whether they may
+    // be read or written stay as they were. The range is `v`'s buffer
+    // (held, so mapped) from the start of its first page, which lies in the
+    // same allocation's mapping or in the heap's: the advice is harmless to
+    // either. A refusal (no transparent huge pages here) changes nothing.
+    let _ = unsafe { rustix::mm::madvise(first, bytes + back, rustix::mm::Advice::LinuxHugepage) };
+}
+
+#[cfg(not(target_os = "linux"))]
+fn advise<T>(_: &mut Vec<T>) {}
+
+#[cfg(test)]
+mod tests {
+    use super::{HUGE_PAGE, filled, reserve};
+
+    /// The advice changes no value: a large vector reads back as written,
+    /// before and after it grows.
+    #[test]
+    fn advised_vectors_keep_their_values() {
+        let n = HUGE_PAGE / 8 * 3;
+        let mut v = filled(n, 7_u64);
+        assert!(v.len() == n && v.iter().all(|&x| x == 7));
+        for (i, x) in v.iter_mut().enumerate() {
+            *x = i as u64;
+        }
+        reserve(&mut v, 2 * n);
+        assert!(v.capacity() >= 2 * n);
+        v.extend(n as u64..2 * n as u64);
+        assert!(v.iter().enumerate().all(|(i, &x)| x == i as u64));
+        let small: Vec<u32> = filled(3, 1);
+        assert_eq!(small, [1, 1, 1]);
+    }
+
+    /// Where the kernel gives huge pages to memory that asks (THP mode
+    /// `madvise` or `always`), a large vector is backed by some: the
+    /// mapping holding it counts them in `/proc/self/smaps`.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_large_vector_gets_huge_pages_where_the_kernel_gives_them() {
+        let mode = std::fs::read_to_string("/sys/kernel/mm/transparent_hugepage/enabled")
+            .unwrap_or_default();
+        let v = filled(3 * HUGE_PAGE / 8, 1_u64);
+        let at = v.as_ptr().addr();
+        let smaps = std::fs::read_to_string("/proc/self/smaps").unwrap();
+        let mut huge_kb = None;
+        let mut inside = false;
+        for line in smaps.lines() {
+            if let Some((range, _)) = line.split_once(' ')
+                && let Some((lo, hi)) = range.split_once('-')
+                && let (Ok(lo), Ok(hi)) =
+                    (usize::from_str_radix(lo, 16), usize::from_str_radix(hi, 16))
+            {
+                inside = (lo..hi).contains(&at);
+            } else if inside && let Some(kb) = line.strip_prefix("AnonHugePages:") {
+                huge_kb = kb.trim().trim_end_matches(" kB").parse::<u64>().ok();
+            }
+        }
+        let huge_kb = huge_kb.unwrap();
+        if mode.contains("[madvise]") || mode.contains("[always]") {
+            assert!(huge_kb >= 2048, "{huge_kb} kB in huge pages ({mode})");
+        }
+        assert!(v.iter().all(|&x| x == 1));
+    }
+}
