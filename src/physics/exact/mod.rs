@@ -197,19 +197,16 @@ impl<Q: EventQueue> EventDriven<Q> {
         cell_grid::CELLS_PER_SPHERE
     }
 
-    /// Whether our bodies are exactly what we last wrote into `world`, and
-    /// it was not touched since (an edit from outside reloads).
+    /// Whether `world` is the one we last wrote, untouched since: its
+    /// generation (every edit from outside a model calls `World::touch`),
+    /// time, size and count are those of our write-back. The edit signal
+    /// is the generation alone, as for `swept`: no pass over the spheres.
     fn matches(&self, world: &World) -> bool {
         self.valid
             && world.generation() == self.synced_generation
             && world.size == self.size
             && world.time == self.synced_time
             && world.spheres.len() == self.bodies.len()
-            && self.order.iter().zip(self.bodies.iter()).all(|(&k, b)| {
-                let s = &world.spheres[k.index()];
-                let kind = self.bodies.species_of(b);
-                s.pos == b.pos && s.vel == b.vel && s.radius == kind.radius && s.mass == kind.mass
-            })
     }
 
     fn load(&mut self, world: &World) {
@@ -519,15 +516,8 @@ impl<Q: EventQueue + Send> Model for EventDriven<Q> {
 
     /// From the broad phase the next step uses anyway (see [`overlap`]); a
     /// world the model does not hold is loaded first, as that step would.
-    /// The world last written, not edited since (`World::touch`), is known
-    /// without comparing every sphere.
     fn max_overlap_rel(&mut self, world: &World, _dt: f64, exec: &dyn Exec) -> Option<f64> {
-        let held = self.valid
-            && world.generation() == self.synced_generation
-            && world.time == self.synced_time
-            && world.size == self.size
-            && world.spheres.len() == self.bodies.len();
-        if !held && !self.matches(world) {
+        if !self.matches(world) {
             self.load(world);
         }
         Some(self.deepest_overlap(exec))
