@@ -23,7 +23,7 @@ const HUGE_PAGE: usize = 2 << 20;
 /// pages when it is that large. Call it before the values are written:
 /// pages written first after it are huge from their first touch.
 pub fn reserve<T>(v: &mut Vec<T>, n: usize) {
-    v.reserve(n.saturating_sub(v.len()));
+    v.reserve_exact(n.saturating_sub(v.len()));
     advise(v);
 }
 
