@@ -35,25 +35,26 @@ pub fn filled<T: Clone>(n: usize, value: T) -> Vec<T> {
     v
 }
 
-/// Ask for huge pages for the whole of `v`'s buffer.
+/// Ask for huge pages for the part of `v`'s buffer that can hold them: the
+/// whole huge pages inside it. Their bounds are page-aligned whatever the
+/// base page size (4, 16 or 64 KB all divide 2 MB), and the range never
+/// leaves the buffer.
 #[cfg(target_os = "linux")]
 fn advise<T>(v: &mut Vec<T>) {
     let bytes = v.capacity() * size_of::<T>();
-    if bytes < HUGE_PAGE {
+    let start = v.as_mut_ptr().cast::<u8>();
+    let skip = start.addr().next_multiple_of(HUGE_PAGE) - start.addr();
+    let len = bytes.saturating_sub(skip) / HUGE_PAGE * HUGE_PAGE;
+    if len == 0 {
         return;
     }
-    let page = rustix::param::page_size();
-    let start = v.as_mut_ptr().cast::<u8>();
-    // madvise wants a page-aligned start: the buffer's first page.
-    let back = start.addr() % page;
-    let first = start.wrapping_sub(back).cast::<std::ffi::c_void>();
+    let first = start.wrapping_add(skip).cast::<std::ffi::c_void>();
     // SAFETY: MADV_HUGEPAGE only changes how the kernel backs the pages of
     // the range with physical memory; their contents and whether they may
-    // be read or written stay as they were. The range is `v`'s buffer
-    // (held, so mapped) from the start of its first page, which lies in the
-    // same allocation's mapping or in the heap's: the advice is harmless to
-    // either. A refusal (no transparent huge pages here) changes nothing.
-    let _ = unsafe { rustix::mm::madvise(first, bytes + back, rustix::mm::Advice::LinuxHugepage) };
+    // be read or written stay as they were. The range lies inside `v`'s
+    // buffer, which `v` holds (so it is mapped), and is aligned as madvise
+    // wants. A refusal (no transparent huge pages here) changes nothing.
+    let _ = unsafe { rustix::mm::madvise(first, len, rustix::mm::Advice::LinuxHugepage) };
 }
 
 #[cfg(not(target_os = "linux"))]
@@ -83,29 +84,28 @@ mod tests {
 
     /// Where the kernel gives huge pages to memory that asks (THP mode
     /// `madvise` or `always`), a large vector is backed by some: the
-    /// mapping holding it counts them in `/proc/self/smaps`.
+    /// mappings over its buffer count them in `/proc/self/smaps` (the
+    /// advice splits a mapping where its range starts and ends).
     #[cfg(target_os = "linux")]
     #[test]
     fn a_large_vector_gets_huge_pages_where_the_kernel_gives_them() {
         let mode = std::fs::read_to_string("/sys/kernel/mm/transparent_hugepage/enabled")
             .unwrap_or_default();
         let v = filled(3 * HUGE_PAGE / 8, 1_u64);
-        let at = v.as_ptr().addr();
+        let buffer = v.as_ptr().addr()..v.as_ptr().addr() + v.len() * 8;
         let smaps = std::fs::read_to_string("/proc/self/smaps").unwrap();
-        let mut huge_kb = None;
-        let mut inside = false;
+        let (mut huge_kb, mut over) = (0, false);
         for line in smaps.lines() {
             if let Some((range, _)) = line.split_once(' ')
                 && let Some((lo, hi)) = range.split_once('-')
                 && let (Ok(lo), Ok(hi)) =
                     (usize::from_str_radix(lo, 16), usize::from_str_radix(hi, 16))
             {
-                inside = (lo..hi).contains(&at);
-            } else if inside && let Some(kb) = line.strip_prefix("AnonHugePages:") {
-                huge_kb = kb.trim().trim_end_matches(" kB").parse::<u64>().ok();
+                over = lo < buffer.end && buffer.start < hi;
+            } else if over && let Some(kb) = line.strip_prefix("AnonHugePages:") {
+                huge_kb += kb.trim().trim_end_matches(" kB").parse::<u64>().unwrap();
             }
         }
-        let huge_kb = huge_kb.unwrap();
         if mode.contains("[madvise]") || mode.contains("[always]") {
             assert!(huge_kb >= 2048, "{huge_kb} kB in huge pages ({mode})");
         }
