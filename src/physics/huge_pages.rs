@@ -7,7 +7,7 @@
 //! kernels (Debian's and Ubuntu's among them) back memory with 2 MB pages
 //! only where the program asks (`/sys/kernel/mm/transparent_hugepage/enabled`
 //! set to `madvise`), and the allocator does not ask. Asking for them made
-//! `exact`'s steady rate 5–16 % higher at 1M spheres, and changed nothing
+//! `exact`'s steady rate 5–20 % higher at 1M spheres, and changed nothing
 //! at 10k, where no array is that large (docs/perf-log.md, 2026-12-05).
 //!
 //! The one `unsafe` call of the crate is here (the crate denies it
