@@ -22,16 +22,27 @@ const HUGE_PAGE: usize = 2 << 20;
 /// Room for `n` values in `v`, in memory the kernel may back with huge
 /// pages when it is that large. Call it before the values are written:
 /// pages written first after it are huge from their first touch.
+/// A buffer already large enough was advised when it was made here.
 pub fn reserve<T>(v: &mut Vec<T>, n: usize) {
+    let had = v.capacity();
     v.reserve_exact(n.saturating_sub(v.len()));
-    advise(v);
+    if v.capacity() != had {
+        advise(v);
+    }
+}
+
+/// `v` emptied and refilled with `n` copies of `value`, in huge pages when
+/// it is large.
+pub fn refill<T: Clone>(v: &mut Vec<T>, n: usize, value: T) {
+    v.clear();
+    reserve(v, n);
+    v.resize(n, value);
 }
 
 /// A vector of `n` copies of `value`, in huge pages when it is large.
 pub fn filled<T: Clone>(n: usize, value: T) -> Vec<T> {
     let mut v = Vec::new();
-    reserve(&mut v, n);
-    v.resize(n, value);
+    refill(&mut v, n, value);
     v
 }
 

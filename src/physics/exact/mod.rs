@@ -233,9 +233,7 @@ impl<Q: EventQueue> EventDriven<Q> {
         for b in self.bodies.iter_mut() {
             b.count = 0;
         }
-        self.slots.clear();
-        super::huge_pages::reserve(&mut self.slots, n);
-        self.slots.resize(n, Slot::default());
+        super::huge_pages::refill(&mut self.slots, n, Slot::default());
         // The old broad phase goes first, so a rebuild never holds two.
         self.broad = Broad::default();
         let filled: f64 = self

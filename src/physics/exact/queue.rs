@@ -124,12 +124,8 @@ impl EventQueue for Tournament {
     /// its sphere, so ties at infinity go to the lowest index too).
     fn reset(&mut self, n: usize) {
         self.size = n.next_power_of_two().max(1);
-        self.keys.clear();
-        huge_pages::reserve(&mut self.keys, 2 * self.size);
-        self.keys.resize(2 * self.size, key(f64::INFINITY));
-        self.ids.clear();
-        huge_pages::reserve(&mut self.ids, self.size.max(2));
-        self.ids.resize(self.size.max(2), 0);
+        huge_pages::refill(&mut self.keys, 2 * self.size, key(f64::INFINITY));
+        huge_pages::refill(&mut self.ids, self.size.max(2), 0);
         self.rebuild();
     }
 

@@ -89,9 +89,7 @@ impl CellGrid {
     pub fn build(&mut self, bodies: &Bodies, size: f64, per_sphere: u32) {
         let n = bodies.len();
         self.list.reset(0, 0);
-        self.place.clear();
-        huge_pages::reserve(&mut self.place, n);
-        self.place.resize(n, BIG);
+        huge_pages::refill(&mut self.place, n, BIG);
         self.bigs.clear();
         self.scan_centre.clear();
         if n == 0 {

@@ -22,17 +22,10 @@ pub struct CellChains {
 impl CellChains {
     /// `spheres` spheres, none in a cell, and `cells` empty cells.
     pub fn reset(&mut self, spheres: usize, cells: usize) {
-        for v in [&mut self.next, &mut self.prev] {
-            v.clear();
-            huge_pages::reserve(v, spheres);
-            v.resize(spheres, Label::NONE);
-        }
-        self.cell.clear();
-        huge_pages::reserve(&mut self.cell, spheres);
-        self.cell.resize(spheres, Cell::NONE);
-        self.head.clear();
-        huge_pages::reserve(&mut self.head, cells);
-        self.head.resize(cells, Label::NONE);
+        huge_pages::refill(&mut self.next, spheres, Label::NONE);
+        huge_pages::refill(&mut self.prev, spheres, Label::NONE);
+        huge_pages::refill(&mut self.cell, spheres, Cell::NONE);
+        huge_pages::refill(&mut self.head, cells, Label::NONE);
     }
 
     #[inline]

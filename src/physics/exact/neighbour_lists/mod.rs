@@ -77,15 +77,9 @@ struct Lists {
 impl Lists {
     fn reset(&mut self, n: usize) {
         self.stride = 32;
-        self.flat.clear();
-        huge_pages::reserve(&mut self.flat, n * self.stride);
-        self.flat.resize(n * self.stride, Link::default());
-        self.len.clear();
-        huge_pages::reserve(&mut self.len, n);
-        self.len.resize(n, 0);
-        self.home.clear();
-        huge_pages::reserve(&mut self.home, n);
-        self.home.resize(n, Home::FLAT);
+        huge_pages::refill(&mut self.flat, n * self.stride, Link::default());
+        huge_pages::refill(&mut self.len, n, 0);
+        huge_pages::refill(&mut self.home, n, Home::FLAT);
         self.big.clear();
     }
 
