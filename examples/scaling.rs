@@ -23,17 +23,19 @@
 //! `exact [rounds] [max N] [renumber]` is the table of `exact` alone; with
 //! `renumber` the model sorts its spheres again as they drift (default:
 //! only at load).
-//! `exact-one N packing steps [dt] [renumber] [calendar]` runs one size only
-//! (for callgrind); with `renumber` the model sorts its spheres again as
-//! they drift, with `calendar` it runs over the calendar queue.
+//! `exact-one N packing steps [dt] [renumber] [calendar|tree]` runs one size
+//! only (for callgrind); with `renumber` the model sorts its spheres again
+//! as they drift, with `calendar` it runs over the calendar queue, with
+//! `tree` over the binary tournament (default: the eight-way one).
 //! `exact-renumber N packing rounds [steps]`: one scene, two models, one
 //! relabelling its spheres in space as they drift (the default) and one
 //! keeping the load's order, run side by side on copies of the world in
 //! blocks of `steps` steps of 2 ms (default 20), timed in alternation:
 //! events per second of each, per round, as the spheres drift from where
 //! the load sorted them.
-//! `exact-queues N packing rounds [steps]`: one scene, the exact model over
-//! its two event queues (tournament tree, calendar), on copies of the world
+//! `exact-queues N packing rounds [steps] [calendar]`: one scene, the exact
+//! model over today's event queue (the eight-way tournament) and another
+//! (the binary tournament, or with `calendar` the calendar), on copies of the world
 //! in blocks of `steps` steps of 2 ms (default 20), timed in alternation:
 //! events per second of each, and each queue's heap bytes a sphere. The
 //! two must process the same events: the counts are compared at the end.
@@ -99,8 +101,10 @@ fn events(s: &EventStats) -> u64 {
 fn exact_one(args: &[String]) {
     if args.iter().any(|a| a == "calendar") {
         exact_one_with(args, EventDriven::<Calendar>::default());
-    } else {
+    } else if args.iter().any(|a| a == "tree") {
         exact_one_with(args, EventDriven::<Tournament>::default());
+    } else {
+        exact_one_with(args, Exact::default());
     }
 }
 
@@ -223,13 +227,22 @@ fn timed_block<Q: EventQueue + Send>(
 }
 
 fn exact_queues(args: &[String]) {
+    if args.iter().any(|a| a == "calendar") {
+        exact_queues_with::<Calendar>(args, "calendar");
+    } else {
+        exact_queues_with::<Tournament>(args, "binary tree");
+    }
+}
+
+/// Today's queue (the eight-way tree) against queue `Q`.
+fn exact_queues_with<Q: EventQueue + Send>(args: &[String], name: &str) {
     let (n, packing, rounds, steps) = side_by_side_args(args);
     let world = exact_scene(n, packing);
     let (mut wt, mut wc) = (world.clone(), world);
-    let mut tree = EventDriven::<Tournament>::default();
-    let mut cal = EventDriven::<Calendar>::default();
+    let mut tree = Exact::default();
+    let mut other = EventDriven::<Q>::default();
     tree.advance(&mut wt, 1e-9, 1, &Serial);
-    cal.advance(&mut wc, 1e-9, 1, &Serial);
+    other.advance(&mut wc, 1e-9, 1, &Serial);
     let (mut total, mut spent) = ([0u64; 2], [0f64; 2]);
     for round in 0..rounds {
         // Which goes first alternates too.
@@ -239,7 +252,7 @@ fn exact_queues(args: &[String]) {
             let (ev, secs) = if k == 0 {
                 timed_block(&mut tree, &mut wt, steps)
             } else {
-                timed_block(&mut cal, &mut wc, steps)
+                timed_block(&mut other, &mut wc, steps)
             };
             total[k] += ev;
             spent[k] += secs;
@@ -247,15 +260,15 @@ fn exact_queues(args: &[String]) {
         }
         let rate = |k: usize| total[k] as f64 / spent[k];
         println!(
-            "round {round}: tournament {:.3} M events/s, calendar {:.3} M events/s; \
-             so far calendar/tournament {:.3}",
+            "round {round}: eight-way {:.3} M events/s, {name} {:.3} M events/s; \
+             so far {name}/eight-way {:.3}",
             rates[0],
             rates[1],
             rate(1) / rate(0)
         );
     }
     assert_eq!(
-        tree.stats, cal.stats,
+        tree.stats, other.stats,
         "the two queues processed different events"
     );
     assert!(
@@ -266,17 +279,17 @@ fn exact_queues(args: &[String]) {
         "the two queues left different worlds"
     );
     println!(
-        "exact-queues N {n} packing {packing}: {} events a model; tournament {:.3} M/s, \
-         calendar {:.3} M/s, calendar/tournament {:.3}; queue heap bytes a sphere: \
-         tournament {:.1}, calendar {:.1}; model heap bytes a sphere: tournament {:.0}, calendar {:.0}",
+        "exact-queues N {n} packing {packing}: {} events a model; eight-way {:.3} M/s, \
+         {name} {:.3} M/s, {name}/eight-way {:.3}; queue heap bytes a sphere: \
+         eight-way {:.1}, {name} {:.1}; model heap bytes a sphere: eight-way {:.0}, {name} {:.0}",
         total[0],
         total[0] as f64 / spent[0] / 1e6,
         total[1] as f64 / spent[1] / 1e6,
         (total[1] as f64 / spent[1]) / (total[0] as f64 / spent[0]),
         tree.queue_heap_bytes() as f64 / n as f64,
-        cal.queue_heap_bytes() as f64 / n as f64,
+        other.queue_heap_bytes() as f64 / n as f64,
         tree.heap_bytes() as f64 / n as f64,
-        cal.heap_bytes() as f64 / n as f64,
+        other.heap_bytes() as f64 / n as f64,
     );
 }
 

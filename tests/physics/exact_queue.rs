@@ -1,11 +1,12 @@
-//! The exact model's two event queues: the calendar must pop in exactly the
-//! tournament tree's order (earliest time, ties by lower sphere index), so
-//! the model gives the same run over either. A proptest drives both with the
-//! same operations and compares every peek; the model over each gives the
-//! same contacts and final state, bit for bit, on a few scenes.
+//! The exact model's event queues: the eight-way tournament (the model's
+//! queue) and the calendar must pop in exactly the binary tournament tree's
+//! order (earliest time, ties by lower sphere index), so the model gives the
+//! same run over any. A proptest drives all three with the same operations
+//! and compares every peek; the model over each gives the same contacts and
+//! final state, bit for bit, on a few scenes.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use crate::common::large::with_three_large;
-use ballpit::physics::exact::{Calendar, Contact, EventDriven, EventQueue, Tournament};
+use ballpit::physics::exact::{Calendar, Contact, EightWay, EventDriven, EventQueue, Tournament};
 use ballpit::physics::{Model, Serial, World};
 use ballpit::scene::lattice::lattice_world;
 use ballpit::scene::{SceneSpec, build_world};
@@ -104,35 +105,42 @@ fn apply<Q: EventQueue>(q: &mut Q, n: usize, op: &Op) {
 }
 
 fn drive(n: usize, start: &[f64], ops: &[Op]) -> Result<(), TestCaseError> {
-    let (mut tree, mut cal) = (Tournament::default(), Calendar::default());
-    for q in [&mut tree as &mut dyn Queue, &mut cal] {
-        q.start(n, start);
-    }
-    prop_assert!(same(tree.peek(), cal.peek()), "after the start");
+    drive_with::<Calendar>(n, start, ops, "calendar")?;
+    drive_with::<EightWay>(n, start, ops, "eight-way")
+}
+
+/// Queue `Q` against the binary tree, op by op.
+fn drive_with<Q: EventQueue>(
+    n: usize,
+    start: &[f64],
+    ops: &[Op],
+    name: &str,
+) -> Result<(), TestCaseError> {
+    let (mut tree, mut other) = (Tournament::default(), Q::default());
+    tree.start(n, start);
+    other.start(n, start);
+    prop_assert!(same(tree.peek(), other.peek()), "{name}: after the start");
     for (k, op) in ops.iter().enumerate() {
         apply(&mut tree, n, op);
-        apply(&mut cal, n, op);
-        let (a, b) = (tree.peek(), cal.peek());
-        prop_assert!(
-            same(a, b),
-            "op {k} {op:?}: tournament {a:?}, calendar {b:?}"
-        );
+        apply(&mut other, n, op);
+        let (a, b) = (tree.peek(), other.peek());
+        prop_assert!(same(a, b), "op {k} {op:?}: tournament {a:?}, {name} {b:?}");
         let i = k * 7919 % n;
-        prop_assert_eq!(tree.time_of(i).to_bits(), cal.time_of(i).to_bits());
+        prop_assert_eq!(tree.time_of(i).to_bits(), other.time_of(i).to_bits());
     }
     // Drain both: the whole order, not only the first.
     for k in 0..n.min(300) {
-        let (a, b) = (tree.peek(), cal.peek());
-        prop_assert!(same(a, b), "drain {k}: tournament {a:?}, calendar {b:?}");
+        let (a, b) = (tree.peek(), other.peek());
+        prop_assert!(same(a, b), "drain {k}: tournament {a:?}, {name} {b:?}");
         if a.1 < n {
             tree.update(a.1, f64::INFINITY);
-            cal.update(b.1, f64::INFINITY);
+            other.update(b.1, f64::INFINITY);
         }
     }
     Ok(())
 }
 
-/// Start both from the same times (set, then rebuilt).
+/// Start each from the same times (set, then rebuilt).
 trait Queue {
     fn start(&mut self, n: usize, times: &[f64]);
 }
@@ -151,7 +159,7 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(400))]
 
     #[test]
-    fn calendar_pops_as_the_tournament_small(
+    fn queues_pop_as_the_tournament_small(
         (n, start, ops) in (1usize..=3).prop_flat_map(|n| (
             Just(n),
             prop::collection::vec(time(), 1..4),
@@ -162,7 +170,7 @@ proptest! {
     }
 
     #[test]
-    fn calendar_pops_as_the_tournament_mid(
+    fn queues_pop_as_the_tournament_mid(
         (n, start, ops) in (4usize..=70).prop_flat_map(|n| (
             Just(n),
             prop::collection::vec(time(), 1..20),
@@ -177,7 +185,7 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(40))]
 
     #[test]
-    fn calendar_pops_as_the_tournament_1000(
+    fn queues_pop_as_the_tournament_1000(
         start in prop::collection::vec(0.0..2.0f64, 1..50),
         ops in prop::collection::vec(op(1000), 0..2000),
     ) {
@@ -193,13 +201,19 @@ fn a_long_schedule_pops_alike() {
     use rand::{Rng, SeedableRng};
     let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(11);
     let n = 1000;
-    let (mut tree, mut cal) = (Tournament::default(), Calendar::default());
+    let (mut tree, mut cal, mut eight) = (
+        Tournament::default(),
+        Calendar::default(),
+        EightWay::default(),
+    );
     let start: Vec<f64> = (0..n).map(|_| rng.random_range(0.0..1.0)).collect();
     tree.start(n, &start);
     cal.start(n, &start);
+    eight.start(n, &start);
     for k in 0..200_000 {
-        let (a, b) = (tree.peek(), cal.peek());
+        let (a, b, e) = (tree.peek(), cal.peek(), eight.peek());
         assert!(same(a, b), "event {k}: tournament {a:?}, calendar {b:?}");
+        assert!(same(a, e), "event {k}: tournament {a:?}, eight-way {e:?}");
         // Exponential waits, a few very long, and exact ties now and then.
         let wait = match rng.random_range(0..100) {
             0 => 1e4,
@@ -208,16 +222,21 @@ fn a_long_schedule_pops_alike() {
         };
         tree.update(a.1, a.0 + wait);
         cal.update(b.1, b.0 + wait);
+        eight.update(e.1, e.0 + wait);
         if k % 50_000 == 49_999 {
             tree.shift(a.0);
             cal.shift(a.0);
+            eight.shift(a.0);
         }
     }
 }
 
+/// The contacts, the final world and the events (as text) of a run.
+type Run = (Vec<Contact>, World, String);
+
 /// The contacts (spheres, time, centres, impulse, bit for bit), the final
 /// world and the events of a run over queue `Q`, with the invariants held.
-fn run<Q: EventQueue + Send>(mut w: World, dt: f64, steps: u64) -> (Vec<Contact>, World, String) {
+fn run<Q: EventQueue + Send>(mut w: World, dt: f64, steps: u64) -> Run {
     let seen = Arc::new(Mutex::new(Vec::new()));
     let sink = Arc::clone(&seen);
     let mut m = EventDriven::<Q>::default();
@@ -253,15 +272,28 @@ fn bits(c: &Contact) -> [u64; 10] {
     ]
 }
 
-/// The two queues give the same run, bit for bit; the run spans more than
+/// The three queues give the same run, bit for bit; the run spans more than
 /// the model's time origin span, so the queues shift too.
 fn alike(label: &str, w: World, dt: f64, steps: u64) {
-    let (ct, wt, st) = run::<Tournament>(w.clone(), dt, steps);
-    let (cc, wc, sc) = run::<Calendar>(w, dt, steps);
+    let tree = run::<Tournament>(w.clone(), dt, steps);
+    alike_runs(
+        &format!("{label}, calendar"),
+        &tree,
+        &run::<Calendar>(w.clone(), dt, steps),
+    );
+    alike_runs(
+        &format!("{label}, eight-way"),
+        &tree,
+        &run::<EightWay>(w, dt, steps),
+    );
+}
+
+/// Two runs, the binary tree's first, the same to the bit.
+fn alike_runs(label: &str, (ct, wt, st): &Run, (cc, wc, sc): &Run) {
     assert!(ct.len() > 1000, "{label}: only {} contacts", ct.len());
     assert_eq!(st, sc, "{label}: events");
     assert_eq!(ct.len(), cc.len(), "{label}: contact count");
-    for (k, (a, b)) in ct.iter().zip(&cc).enumerate() {
+    for (k, (a, b)) in ct.iter().zip(cc).enumerate() {
         assert_eq!(bits(a), bits(b), "{label}: contact {k}");
     }
     for (k, (a, b)) in wt.spheres.iter().zip(&wc.spheres).enumerate() {

@@ -5,8 +5,10 @@
 //! - lazy update: each sphere carries its own time stamp ([`body`]) and is
 //!   moved only when an event touches it or when `advance` returns;
 //! - one pending event per sphere (the earliest of contact, wall, or its
-//!   broad-phase event), in an [`EventQueue`] (a tournament tree; the
-//!   bucket queue `calendar` is an experiment, feature `experiments`);
+//!   broad-phase event), in an [`EventQueue`] (a tournament tree of eight
+//!   children a node, [`EightWay`]; the binary tree and the bucket queue
+//!   `calendar` it was measured against are experiments, feature
+//!   `experiments`);
 //! - a broad phase chosen by packing fraction ([`LISTS_ABOVE_PACKING`]):
 //!   a cell grid with cell-crossing events for dilute and moderate scenes
 //!   ([`cell_grid`]), neighbour lists with a skin for dense ones
@@ -46,6 +48,7 @@ pub mod body;
 #[cfg(feature = "experiments")]
 mod calendar;
 pub mod cell_grid;
+mod eight_way;
 #[cfg(feature = "experiments")]
 mod hooks;
 mod ids;
@@ -58,6 +61,8 @@ mod renumber;
 pub mod schedule;
 mod spatial;
 mod species;
+#[cfg(feature = "experiments")]
+mod tournament;
 
 use super::contact::{reflect_walls, resolve_pair};
 use super::exec::Exec;
@@ -69,12 +74,15 @@ use body::Bodies;
 #[cfg(feature = "experiments")]
 pub use calendar::Calendar;
 use cell_grid::CellGrid;
+pub use eight_way::EightWay;
 #[cfg(feature = "experiments")]
 pub use hooks::{Contact, Observer};
 use ids::{Label, WorldId};
 use neighbour_lists::NeighbourLists;
-pub use queue::{EventQueue, Tournament};
+pub use queue::EventQueue;
 use schedule::{Event, Kind, Predictor, Queued, Slot};
+#[cfg(feature = "experiments")]
+pub use tournament::Tournament;
 
 /// Events (contacts, wall hits, relists, stale predictions) a step may take,
 /// at least; scenes add [`EVENT_CAP_PER_SPHERE`] per sphere.
@@ -105,13 +113,15 @@ impl Default for Broad {
     }
 }
 
-/// The model, with today's event queue. The tournament stays the default:
-/// the calendar measured slower at 10k spheres and at packing 0.1 and 0.4,
-/// faster only at 1M dilute (docs/benchmarks.md, "exact's event queue").
-pub type Exact = EventDriven<Tournament>;
+/// The model, with today's event queue: the eight-way tournament, faster
+/// than the binary one from 4k to 1M spheres and level at 4k dense; the
+/// calendar measured slower but at 1M dilute (docs/benchmarks.md,
+/// "exact's event queue", and the 2026-12-05 entry of docs/perf-log.md).
+pub type Exact = EventDriven<EightWay>;
 
-/// The model over an event queue `Q` ([`Tournament`] or `Calendar`; a
-/// type parameter, so both run in one binary at no cost to either).
+/// The model over an event queue `Q` ([`EightWay`], or the experiments'
+/// `Tournament` and `Calendar`; a type parameter, so all run in one binary
+/// at no cost to any).
 #[derive(Default)]
 pub struct EventDriven<Q: EventQueue> {
     bodies: Bodies,
