@@ -17,9 +17,10 @@
 //! sphere of a process that builds the scene and runs two steps (a child
 //! process per size, less what it held before the scene), then blocks of steps (`exact`: 2 ms, 100
 //! at 10k, 10 at 100k, 1 at 1M; the others: 1/60 s, 20, 2 and 1) timed in
-//! alternation between the sizes: ns per sphere-step and events per second
+//! alternation between the sizes: ns per sphere-step, events per second
 //! (`exact`: collisions, crossings, walls, relists, stale; the others:
-//! sphere and wall contacts), each against 10k's.
+//! sphere and wall contacts) and sphere collisions per CPU second (issue
+//! 31's table), each against 10k's.
 //! `exact [rounds] [max N] [renumber]` is the table of `exact` alone; with
 //! `renumber` the model sorts its spheres again as they drift (default:
 //! only at load).
@@ -46,6 +47,7 @@
 //! itself never reorders the world (the screen, the CSV and the model
 //! comparisons read spheres by index).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap fails the run
+use ballpit::cpu::{current_tid, thread_cpu_seconds_of};
 use ballpit::physics::exact::{Calendar, EventDriven, EventQueue, EventStats, Exact, Tournament};
 use ballpit::physics::sphere::volume;
 use ballpit::physics::{Model, ModelKind, Serial, World};
@@ -351,6 +353,10 @@ struct Run {
     spent: Duration,
     events: u64,
     steps: u64,
+    /// CPU seconds of the timed blocks (this thread's), and the sphere
+    /// collisions in them: the issue-31 table's rate.
+    cpu: f64,
+    collisions: u64,
 }
 
 /// `table [rounds] [max N] [model ...] [renumber]` (and `exact ...`, the
@@ -415,6 +421,8 @@ fn build_runs(
             spent: Duration::ZERO,
             events: 0,
             steps: 0,
+            cpu: 0.0,
+            collisions: 0,
         });
     }
     runs
@@ -458,19 +466,29 @@ fn peak(args: &[String]) {
     println!("{}", grown as f64 * 1024.0 / n as f64);
 }
 
+/// CPU seconds this thread has run (exact: from the scheduler's count).
+fn cpu_now() -> f64 {
+    current_tid()
+        .and_then(thread_cpu_seconds_of)
+        .expect("this thread's CPU time")
+}
+
 fn time_runs(mut runs: Vec<Run>, rounds: usize, dt: f64, kind: ModelKind, packing: f64) {
     for _ in 0..rounds {
         for r in &mut runs {
             // Untimed: the caches after the other sizes.
             r.model.model().advance(&mut r.world, dt, 1, &Serial);
-            let e0 = r.model.events(&r.world);
-            let start = Instant::now();
+            let (e0, c0) = (r.model.events(&r.world), r.world.counters.sphere_collisions);
+            let (start, cpu) = (Instant::now(), cpu_now());
             r.model.model().advance(&mut r.world, dt, r.block, &Serial);
+            r.cpu += cpu_now() - cpu;
             r.spent += start.elapsed();
             r.events += r.model.events(&r.world) - e0;
+            r.collisions += r.world.counters.sphere_collisions - c0;
             r.steps += r.block;
         }
     }
+    let per_cpu = |r: &Run| r.collisions as f64 / r.cpu;
     let rate = |r: &Run| r.events as f64 / r.spent.as_secs_f64();
     let ns = |r: &Run| r.spent.as_secs_f64() / (r.steps as f64 * r.n as f64) * 1e9;
     let (base_rate, base_ns) = (rate(&runs[0]), ns(&runs[0]));
@@ -481,7 +499,7 @@ fn time_runs(mut runs: Vec<Run>, rounds: usize, dt: f64, kind: ModelKind, packin
         println!(
             "{kind} packing {packing} N {}: load {:.3} s, {heap}{:.0} peak bytes a sphere, \
              {:.0} ns a sphere-step (this / 10k: {:.2}), {:.3} M events/s (10k rate / this: {:.2}), \
-             {} events, escaped {}",
+             {:.4} M sphere collisions per CPU second (10k / this: {:.2}), {} events, escaped {}",
             r.n,
             r.load,
             r.peak,
@@ -489,6 +507,8 @@ fn time_runs(mut runs: Vec<Run>, rounds: usize, dt: f64, kind: ModelKind, packin
             ns(r) / base_ns,
             rate(r) / 1e6,
             base_rate / rate(r),
+            per_cpu(r) / 1e6,
+            per_cpu(&runs[0]) / per_cpu(r),
             r.events,
             r.world.escaped()
         );
