@@ -5,13 +5,14 @@ use crate::physics::ModelKind;
 
 /// Peak bytes a sphere costs while a model steps headless (`bench`), with a
 /// quarter for margin (peak RSS at a million spheres less the empty process,
-/// packing 0.005 and 0.1, the larger; docs/benchmarks.md has the runs).
+/// the largest of packing 0.005, 0.1 and the dense preset: 194, 273 and 319
+/// B; docs/benchmarks.md has the runs).
 pub fn sphere_bytes(model: ModelKind) -> u64 {
     match model {
         ModelKind::Discrete => 243,
+        ModelKind::Swept => 342,
         // `auto` may run any: the hungriest.
-        ModelKind::Swept | ModelKind::Auto(_) => 285,
-        ModelKind::Exact => 250,
+        ModelKind::Exact | ModelKind::Auto(_) => 399,
     }
 }
 
@@ -133,7 +134,7 @@ mod tests {
         assert!(check(1_000_000, Some(ModelKind::Swept), free).is_ok());
         let err = check(10_000_000, Some(ModelKind::Exact), free).unwrap_err();
         assert!(
-            err.starts_with("10000000 spheres would need about 2400 MiB"),
+            err.starts_with("10000000 spheres would need about 3821 MiB"),
             "{err}"
         );
         assert!(
@@ -153,18 +154,18 @@ mod tests {
         let tight = Some(40u64 << 20);
         assert!(check(0, Some(ModelKind::Swept), tight).is_ok());
         assert!(check(1, Some(ModelKind::Swept), tight).is_ok());
-        // Half of the 24 MiB beyond it: 44 000 spheres at 285 bytes.
-        assert!(check(44_000, Some(ModelKind::Swept), tight).is_ok());
-        assert!(check(45_000, Some(ModelKind::Swept), tight).is_err());
+        // Half of the 24 MiB beyond it: 36 792 spheres at 342 bytes.
+        assert!(check(36_700, Some(ModelKind::Swept), tight).is_ok());
+        assert!(check(36_800, Some(ModelKind::Swept), tight).is_err());
         assert!(check(0, Some(ModelKind::Swept), Some(8 << 20)).is_err());
         assert_eq!(need(usize::MAX, None), u64::MAX);
         // The screen's short form refuses the same counts.
         // The screen's short form: the app's count (hungriest model and the
-        // screen's copies, 415 bytes a sphere) against the same share.
+        // screen's copies, 529 bytes a sphere) against the same share.
         assert!(count_notice(20_000, tight).is_none());
         assert_eq!(
             count_notice(1_000_000, tight).unwrap(),
-            "count limit: 1000000 spheres need 411 MiB, over the 28 MiB a run may use"
+            "count limit: 1000000 spheres need 520 MiB, over the 28 MiB a run may use"
         );
     }
 }
