@@ -71,8 +71,3 @@ impl Label {
     /// No body: the end of a chain.
     pub const NONE: Label = Label(u32::MAX);
 }
-
-impl Cell {
-    /// In no cell (a large sphere, on the second level).
-    pub const NONE: Cell = Cell(u32::MAX);
-}

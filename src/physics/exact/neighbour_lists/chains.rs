@@ -1,8 +1,12 @@
 //! The neighbour lists' grid: the spheres of each cell (by list centre) as
-//! intrusive doubly linked chains, so a sphere moves between cells in O(1)
-//! at a relist. Only rebuilds walk it; the cell-crossing broad phase, which
-//! gathers cells far more often, keeps its cells in
+//! intrusive singly linked chains, so a sphere moves between cells at a
+//! relist by unlinking it from its old cell's chain (a few spheres at most:
+//! cells are about a sphere and its skin wide) and pushing it on the new.
+//! Only rebuilds walk it; the cell-crossing broad phase, which gathers
+//! cells far more often, keeps its cells in
 //! [`CellBlocks`](crate::physics::exact::cell_grid::blocks::CellBlocks) instead.
+//! A sphere's cell is not stored: its owner recomputes it from the list
+//! centre, which is where the sphere was put in.
 use crate::physics::exact::ids::{Cell, Label};
 #[cfg(feature = "experiments")]
 use crate::physics::exact::renumber::apply;
@@ -12,76 +16,64 @@ use crate::physics::huge_pages;
 pub struct CellChains {
     /// Each cell's first sphere, [`Label::NONE`] for an empty one.
     head: Vec<Label>,
-    /// Each sphere's neighbours in its chain, [`Label::NONE`] at the ends.
+    /// The next sphere in each sphere's chain, [`Label::NONE`] at the end.
     next: Vec<Label>,
-    prev: Vec<Label>,
-    /// The cell of each sphere, [`Cell::NONE`] for one in no cell.
-    cell: Vec<Cell>,
 }
 
 impl CellChains {
     /// `spheres` spheres, none in a cell, and `cells` empty cells.
     pub fn reset(&mut self, spheres: usize, cells: usize) {
         huge_pages::refill(&mut self.next, spheres, Label::NONE);
-        huge_pages::refill(&mut self.prev, spheres, Label::NONE);
-        huge_pages::refill(&mut self.cell, spheres, Cell::NONE);
         huge_pages::refill(&mut self.head, cells, Label::NONE);
-    }
-
-    #[inline]
-    pub fn cell(&self, i: Label) -> Cell {
-        self.cell[i.index()]
     }
 
     /// Bytes held on the heap.
     pub fn heap_bytes(&self) -> usize {
-        let labels: usize = [&self.head, &self.next, &self.prev]
-            .iter()
-            .map(|v| v.capacity() * size_of::<Label>())
-            .sum();
-        labels + self.cell.capacity() * size_of::<Cell>()
+        (self.head.capacity() + self.next.capacity()) * size_of::<Label>()
     }
 
-    pub fn insert(&mut self, i: Label, c: usize) {
-        let head = self.head[c];
-        self.cell[i.index()] = Cell::at(c);
-        self.prev[i.index()] = Label::NONE;
-        self.next[i.index()] = head;
-        if head != Label::NONE {
-            self.prev[head.index()] = i;
-        }
-        self.head[c] = i;
+    /// Put sphere `i` first in cell `c`.
+    pub fn insert(&mut self, i: Label, c: Cell) {
+        let head = &mut self.head[c.index()];
+        self.next[i.index()] = *head;
+        *head = i;
     }
 
-    pub fn remove(&mut self, i: Label) {
-        let (p, n) = (self.prev[i.index()], self.next[i.index()]);
-        if p == Label::NONE {
-            self.head[self.cell[i.index()].index()] = n;
-        } else {
-            self.next[p.index()] = n;
+    /// Take sphere `i` out of cell `c`, its cell; the others keep their order.
+    pub fn remove(&mut self, i: Label, c: Cell) {
+        let after = self.next[i.index()];
+        let mut at = self.head[c.index()];
+        if at == i {
+            self.head[c.index()] = after;
+            return;
         }
-        if n != Label::NONE {
-            self.prev[n.index()] = p;
+        while at != Label::NONE {
+            let n = self.next[at.index()];
+            if n == i {
+                self.next[at.index()] = after;
+                return;
+            }
+            at = n;
         }
+        debug_assert!(false, "sphere {i:?} is not in cell {c:?}");
     }
 
     /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
     /// every chain keeps its order.
     #[cfg(feature = "experiments")]
     pub fn relabel(&mut self, perm: &[Label], inv: &[Label]) {
-        for v in [&mut self.head, &mut self.next, &mut self.prev] {
+        for v in [&mut self.head, &mut self.next] {
             for x in v.iter_mut().filter(|x| **x != Label::NONE) {
                 *x = inv[x.index()];
             }
         }
         apply(&mut self.next, perm);
-        apply(&mut self.prev, perm);
-        apply(&mut self.cell, perm);
     }
 
-    pub fn move_to(&mut self, i: Label, c: usize) {
-        self.remove(i);
-        self.insert(i, c);
+    /// Sphere `i` from cell `from` to cell `to`, first there.
+    pub fn move_to(&mut self, i: Label, from: Cell, to: Cell) {
+        self.remove(i, from);
+        self.insert(i, to);
     }
 
     /// Every sphere in cell `c`.
@@ -92,5 +84,37 @@ impl CellChains {
             f(j);
             j = self.next[j.index()];
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cell(ch: &CellChains, c: usize) -> Vec<usize> {
+        let mut v = Vec::new();
+        ch.for_each_in(c, |j| v.push(j.index()));
+        v
+    }
+
+    /// Removing from the head, the middle and the end keeps the others'
+    /// order, as the doubly linked chains did.
+    #[test]
+    fn removal_keeps_the_order_of_the_rest() {
+        let mut ch = CellChains::default();
+        ch.reset(6, 2);
+        for i in 0..5 {
+            ch.insert(Label::at(i), Cell::at(0));
+        }
+        assert_eq!(cell(&ch, 0), [4, 3, 2, 1, 0]);
+        ch.remove(Label::at(2), Cell::at(0));
+        assert_eq!(cell(&ch, 0), [4, 3, 1, 0]);
+        ch.remove(Label::at(4), Cell::at(0));
+        assert_eq!(cell(&ch, 0), [3, 1, 0]);
+        ch.move_to(Label::at(0), Cell::at(0), Cell::at(1));
+        assert_eq!(cell(&ch, 0), [3, 1]);
+        assert_eq!(cell(&ch, 1), [0]);
+        ch.insert(Label::at(5), Cell::at(1));
+        assert_eq!(cell(&ch, 1), [5, 0]);
     }
 }

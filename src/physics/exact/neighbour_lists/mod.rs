@@ -117,6 +117,12 @@ impl Lists {
         self.set_stride((longest + HEADROOM).next_multiple_of(STRIDE_STEP));
     }
 
+    /// Whether `i` is a large sphere (its list growable, itself in no cell).
+    #[inline]
+    fn is_big(&self, i: Label) -> bool {
+        self.home[i.index()] != Home::FLAT
+    }
+
     fn make_big(&mut self, i: Label) {
         self.home[i.index()] = Home(self.big.len() as u32);
         self.big.push(Vec::new());
@@ -307,7 +313,7 @@ impl NeighbourLists {
                 self.bigs.push(i);
                 self.lists.make_big(i);
             } else {
-                self.cells.insert(i, self.cell_index(b.pos));
+                self.cells.insert(i, self.cell_of(b.pos));
             }
         }
         // Count, size the flat array once, then link: growing it while
@@ -324,10 +330,12 @@ impl NeighbourLists {
     /// Sphere `i` (moved to the current time) gets a new centre and list.
     pub fn rebuild(&mut self, i: Label, bodies: &Bodies) {
         self.lists.unlink_all(i);
-        self.centre[i.index()].pos = bodies[i].pos;
-        if self.cells.cell(i) != Cell::NONE {
-            self.cells.move_to(i, self.cell_index(bodies[i].pos));
+        if !self.lists.is_big(i) {
+            // The cell it was put in: its old centre's.
+            let from = self.cell_of(self.centre[i.index()].pos);
+            self.cells.move_to(i, from, self.cell_of(bodies[i].pos));
         }
+        self.centre[i.index()].pos = bodies[i].pos;
         self.scan(i, bodies, |j| j != i, Lists::link);
     }
 
@@ -380,7 +388,7 @@ impl NeighbourLists {
                 found(lists, i, j);
             }
         };
-        let big = self.cells.cell(i) == Cell::NONE;
+        let big = self.lists.is_big(i);
         let reach = if big {
             bodies.radius(i) + self.small_rmax + 2.0 * self.skin
         } else {
@@ -417,9 +425,9 @@ impl NeighbourLists {
         [c(p.x), c(p.y), c(p.z)]
     }
 
-    fn cell_index(&self, p: DVec3) -> usize {
+    fn cell_of(&self, p: DVec3) -> Cell {
         let [x, y, z] = self.coords(p);
-        x + self.per_side * (y + self.per_side * z)
+        Cell::at(x + self.per_side * (y + self.per_side * z))
     }
 }
 
