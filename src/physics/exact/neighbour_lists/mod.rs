@@ -60,13 +60,28 @@ pub struct Link {
     pub j: Label,
 }
 
-/// Where a sphere's list is kept: in the flat array (a bulk sphere) or,
-/// `Home(k)`, the `k`th of the large spheres' own lists.
+/// Where a sphere's list is kept, as its word in `Lists::len` says: in the
+/// flat array with this length (a bulk sphere), or the `Big(k)`th of the
+/// large spheres' own lists (the word's top bit set). One word a sphere,
+/// read by every look-up.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Home(u32);
+enum Home {
+    Flat(usize),
+    Big(usize),
+}
+
+/// The top bit of a `Lists::len` word: a large sphere's list.
+const BIG: u32 = 1 << 31;
 
 impl Home {
-    const FLAT: Home = Home(u32::MAX);
+    #[inline(always)]
+    fn of(word: u32) -> Home {
+        if word & BIG == 0 {
+            Home::Flat(word as usize)
+        } else {
+            Home::Big((word & !BIG) as usize)
+        }
+    }
 }
 
 /// Neighbour lists of the bulk spheres in one flat array with one stride
@@ -77,8 +92,9 @@ impl Home {
 struct Lists {
     stride: usize,
     flat: Vec<Link>,
+    /// Each sphere's [`Home`] as a word: its flat list's length, or
+    /// [`BIG`] and its place in `big`.
     len: Vec<u32>,
-    home: Vec<Home>,
     big: Vec<Vec<Link>>,
 }
 
@@ -86,7 +102,6 @@ impl Lists {
     /// Empty lists for `n` spheres, all in the flat array at `stride`.
     fn reset(&mut self, n: usize, stride: usize) {
         huge_pages::refill(&mut self.len, n, 0);
-        huge_pages::refill(&mut self.home, n, Home::FLAT);
         self.big.clear();
         self.set_stride(stride);
     }
@@ -97,14 +112,16 @@ impl Lists {
         self.stride = stride;
         self.flat = Vec::new();
         self.flat = huge_pages::filled(self.len.len() * stride, Link::default());
-        self.len.fill(0);
+        for w in self.len.iter_mut().filter(|w| **w & BIG == 0) {
+            *w = 0;
+        }
     }
 
     /// Count a pair found by a build's first pass (in the lengths).
     #[inline]
     fn count(&mut self, i: Label, j: Label) {
         for k in [i, j] {
-            if self.home[k.index()] == Home::FLAT {
+            if !self.is_big(k) {
                 self.len[k.index()] += 1;
             }
         }
@@ -113,67 +130,63 @@ impl Lists {
     /// After a build's counting pass: a stride with room for [`HEADROOM`]
     /// more links than the longest list, every list empty again.
     fn fit_counts(&mut self) {
-        let longest = self.len.iter().copied().max().unwrap_or(0) as usize;
+        let flat = self.len.iter().filter(|&&w| w & BIG == 0);
+        let longest = flat.copied().max().unwrap_or(0) as usize;
         self.set_stride((longest + HEADROOM).next_multiple_of(STRIDE_STEP));
     }
 
     /// Whether `i` is a large sphere (its list growable, itself in no cell).
     #[inline]
     fn is_big(&self, i: Label) -> bool {
-        self.home[i.index()] != Home::FLAT
+        self.len[i.index()] & BIG != 0
     }
 
     fn make_big(&mut self, i: Label) {
-        self.home[i.index()] = Home(self.big.len() as u32);
+        self.len[i.index()] = BIG | self.big.len() as u32;
         self.big.push(Vec::new());
     }
 
-    /// Where bulk sphere `i`'s list starts in `flat`, and its length.
     #[inline(always)]
-    fn flat_range(&self, i: usize) -> std::ops::Range<usize> {
-        i * self.stride..i * self.stride + self.len[i] as usize
+    fn home(&self, i: Label) -> Home {
+        Home::of(self.len[i.index()])
     }
 
     #[inline]
     fn of(&self, i: Label) -> &[Link] {
-        match self.home[i.index()] {
-            Home::FLAT => &self.flat[self.flat_range(i.index())],
-            Home(k) => &self.big[k as usize],
+        match self.home(i) {
+            Home::Flat(len) => &self.flat[i.index() * self.stride..][..len],
+            Home::Big(k) => &self.big[k],
         }
     }
 
     #[inline]
     fn of_mut(&mut self, i: Label) -> &mut [Link] {
-        match self.home[i.index()] {
-            Home::FLAT => {
-                let r = self.flat_range(i.index());
-                &mut self.flat[r]
-            }
-            Home(k) => &mut self.big[k as usize],
+        match self.home(i) {
+            Home::Flat(len) => &mut self.flat[i.index() * self.stride..][..len],
+            Home::Big(k) => &mut self.big[k],
         }
     }
 
     #[inline]
     fn push(&mut self, i: Label, l: Link) {
-        let i = i.index();
-        match self.home[i] {
-            Home::FLAT => {
-                if self.len[i] as usize == self.stride {
+        match self.home(i) {
+            Home::Flat(len) => {
+                if len == self.stride {
                     self.grow();
                 }
-                self.flat[i * self.stride + self.len[i] as usize] = l;
-                self.len[i] += 1;
+                self.flat[i.index() * self.stride + len] = l;
+                self.len[i.index()] += 1;
             }
-            Home(k) => self.big[k as usize].push(l),
+            Home::Big(k) => self.big[k].push(l),
         }
     }
 
     #[inline]
     fn pop(&mut self, i: Label) {
-        match self.home[i.index()] {
-            Home::FLAT => self.len[i.index()] -= 1,
-            Home(k) => {
-                self.big[k as usize].pop();
+        match self.home(i) {
+            Home::Flat(_) => self.len[i.index()] -= 1,
+            Home::Big(k) => {
+                self.big[k].pop();
             }
         }
     }
@@ -200,9 +213,9 @@ impl Lists {
                 self.pop(j);
             }
         }
-        match self.home[i.index()] {
-            Home::FLAT => self.len[i.index()] = 0,
-            Home(k) => self.big[k as usize].clear(),
+        match self.home(i) {
+            Home::Flat(_) => self.len[i.index()] = 0,
+            Home::Big(k) => self.big[k].clear(),
         }
     }
 
@@ -212,9 +225,8 @@ impl Lists {
     fn relabel(&mut self, perm: &[Label], inv: &[Label]) {
         apply_chunks(&mut self.flat, self.stride, perm);
         apply(&mut self.len, perm);
-        apply(&mut self.home, perm);
         for i in 0..self.len.len() {
-            if self.home[i] == Home::FLAT {
+            if !self.is_big(Label::at(i)) {
                 for l in self.of_mut(Label::at(i)) {
                     l.j = inv[l.j.index()];
                 }
@@ -237,9 +249,10 @@ impl Lists {
         let (old, n) = (self.stride, self.len.len());
         huge_pages::reserve(&mut self.flat, n * stride);
         self.flat.resize(n * stride, Link::default());
-        for (i, &l) in self.len.iter().enumerate().rev() {
-            self.flat
-                .copy_within(i * old..i * old + l as usize, i * stride);
+        for (i, &w) in self.len.iter().enumerate().rev() {
+            if let Home::Flat(len) = Home::of(w) {
+                self.flat.copy_within(i * old..i * old + len, i * stride);
+            }
         }
         self.stride = stride;
     }
@@ -266,7 +279,6 @@ impl NeighbourLists {
         self.centre.capacity() * size_of::<Centre>()
             + l.flat.capacity() * size_of::<Link>()
             + l.len.capacity() * 4
-            + l.home.capacity() * size_of::<Home>()
             + self.bigs.capacity() * size_of::<Label>()
             + l.big.capacity() * size_of::<Vec<Link>>()
             + big
@@ -470,6 +482,9 @@ mod tests {
         let n = 30;
         l.reset(n, STRIDE_STEP);
         let at = Label::at;
+        // Sphere 25 is large: its list is its own, whatever the stride.
+        l.make_big(at(25));
+        l.link(at(25), at(1));
         // Sphere 0 neighbours 1..=20 (past two strides); 1..=3 also
         // neighbour 29, and 29 is last in memory, so its list moves first.
         for j in 1..=20 {
@@ -482,16 +497,25 @@ mod tests {
         let ids = |l: &Lists, i| l.of(at(i)).iter().map(|k| k.j.index()).collect::<Vec<_>>();
         assert_eq!(ids(&l, 0), (1..=20).collect::<Vec<_>>());
         assert_eq!(ids(&l, 29), [1, 2, 3]);
-        for j in 1..=3 {
+        assert_eq!(ids(&l, 1), [25, 0, 29]);
+        for j in 2..=3 {
             assert_eq!(ids(&l, j), [0, 29], "list of {j}");
         }
+        assert!(l.is_big(at(25)) && !l.is_big(at(0)));
+        assert_eq!(ids(&l, 25), [1]);
         let mut c = Lists::default();
         c.reset(n, 0);
+        c.make_big(at(25));
         for j in 1..=20 {
             c.count(at(0), at(j));
+            // A large sphere's many neighbours do not size the stride.
+            c.count(at(25), at(j));
         }
         c.fit_counts();
         assert_eq!(c.stride, (20 + HEADROOM).next_multiple_of(STRIDE_STEP));
         assert_eq!(ids(&c, 0), Vec::<usize>::new());
+        assert!(c.is_big(at(25)));
+        c.link(at(25), at(4));
+        assert_eq!(ids(&c, 25), [4]);
     }
 }
