@@ -74,6 +74,11 @@ impl Bodies {
     }
 
     #[inline(always)]
+    pub fn radius_of_species(&self, s: SpeciesId) -> f64 {
+        self.species.get(s).radius
+    }
+
+    #[inline(always)]
     pub fn radius(&self, i: Label) -> f64 {
         self.radius_of(&self[i])
     }
