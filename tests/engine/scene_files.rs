@@ -26,7 +26,14 @@ fn dir(test: &str) -> PathBuf {
     d
 }
 
+/// The child's peak resident size, once it runs ballpit: between fork and
+/// exec it is a copy of the test process, whose high-water mark (the other
+/// tests' worlds) it carries until the exec.
 fn vm_hwm_kb(pid: u32) -> Option<u64> {
+    let comm = std::fs::read_to_string(format!("/proc/{pid}/comm")).ok()?;
+    if comm.trim_end() != "ballpit" {
+        return None;
+    }
     let status = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     line.split_whitespace().nth(1)?.parse().ok()
