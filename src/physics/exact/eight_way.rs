@@ -1,9 +1,9 @@
-//! An eight-way tournament ([`EightWay`]): the binary [`super::Tournament`]
-//! with eight children a node, so a node's children are one cache line of
-//! keys. An update climbs log8 N levels instead of log2 N: 7 lines at a
-//! million spheres where the binary tree touched 20 (the lower ones missed
-//! the cache at that size), and the inner nodes take a seventh of the leaves'
-//! memory instead of as much again.
+//! An eight-way tournament ([`EightWay`]): the binary tournament
+//! (`tournament.rs`) with eight children a node, so a node's children are
+//! one cache line of keys. An update climbs log8 N levels instead of
+//! log2 N: 7 lines at a million spheres where the binary tree touched 20
+//! (the lower ones missed the cache at that size), and the inner nodes take
+//! a seventh of the leaves' memory instead of as much again.
 //!
 //! Ties go to the lowest sphere index at every node (the leftmost of the
 //! least keys), so the root is the least `(time, sphere)`: the order the
