@@ -70,7 +70,7 @@ impl Bodies {
 
     #[inline(always)]
     pub fn radius_of(&self, b: &Body) -> f64 {
-        self.species.get(b.species).radius
+        self.radius_of_species(b.species)
     }
 
     #[inline(always)]

@@ -92,6 +92,15 @@ impl Home {
             Home::Big((word & !BIG) as usize)
         }
     }
+
+    /// The length of a flat list (none for a large sphere's).
+    #[inline(always)]
+    fn flat_len(word: u32) -> Option<usize> {
+        match Home::of(word) {
+            Home::Flat(len) => Some(len),
+            Home::Big(_) => None,
+        }
+    }
 }
 
 /// Neighbour lists of the bulk spheres in one flat array with one stride
@@ -122,7 +131,11 @@ impl Lists {
         self.stride = stride;
         self.flat = Vec::new();
         self.flat = huge_pages::filled(self.len.len() * stride, Link::default());
-        for w in self.len.iter_mut().filter(|w| **w & BIG == 0) {
+        for w in self
+            .len
+            .iter_mut()
+            .filter(|w| Home::flat_len(**w).is_some())
+        {
             *w = 0;
         }
     }
@@ -140,15 +153,15 @@ impl Lists {
     /// After a build's counting pass: a stride with room for [`HEADROOM`]
     /// more links than the longest list, every list empty again.
     fn fit_counts(&mut self) {
-        let flat = self.len.iter().filter(|&&w| w & BIG == 0);
-        let longest = flat.copied().max().unwrap_or(0) as usize;
+        let longest = self.len.iter().filter_map(|&w| Home::flat_len(w)).max();
+        let longest = longest.unwrap_or(0);
         self.set_stride((longest + HEADROOM).next_multiple_of(STRIDE_STEP));
     }
 
     /// Whether `i` is a large sphere (its list growable, itself in no cell).
     #[inline]
     fn is_big(&self, i: Label) -> bool {
-        self.len[i.index()] & BIG != 0
+        Home::flat_len(self.len[i.index()]).is_none()
     }
 
     fn make_big(&mut self, i: Label) {
@@ -260,7 +273,7 @@ impl Lists {
         huge_pages::reserve(&mut self.flat, n * stride);
         self.flat.resize(n * stride, Link::default());
         for (i, &w) in self.len.iter().enumerate().rev() {
-            if let Home::Flat(len) = Home::of(w) {
+            if let Some(len) = Home::flat_len(w) {
                 self.flat.copy_within(i * old..i * old + len, i * stride);
             }
         }
