@@ -10,9 +10,10 @@
 //! `exact`'s steady rate 5–20 % higher at 1M spheres, and changed nothing
 //! at 10k, where no array is that large (docs/perf-log.md, 2026-12-05).
 //!
-//! The one `unsafe` call of the crate is here (the crate denies it
-//! everywhere else): `madvise` takes a raw address, though this advice
-//! never changes what the memory holds or who may touch it.
+//! One of the crate's two `unsafe` calls is here (the other is the
+//! prefetch hint of `prefetch.rs`; the crate denies it everywhere else):
+//! `madvise` takes a raw address, though this advice never changes what the
+//! memory holds or who may touch it.
 #![allow(unsafe_code)]
 
 /// Arrays from this size up are advised: one huge page on x86-64 and on

@@ -296,6 +296,20 @@ fn record(mut w: World, m: Exact, dt: f64, steps: u64) -> (Vec<[u64; 4]>, World,
     (contacts, w, m.stats.renumberings)
 }
 
+/// Two scenes of 3000 spheres, with their step and steps: a dense one (on
+/// neighbour lists) and a dilute one (on cells) with three large spheres
+/// among them, 3.5 to 4.3 times the rest (on the second level, clear of
+/// the lattice neighbours).
+fn lists_and_cells_scenes() -> [(World, f64, u64); 2] {
+    let mut dilute = lattice_world(3000, 0.02, 1.0, 9).expect("lattice");
+    for (k, s) in dilute.spheres.iter_mut().step_by(1000).enumerate() {
+        s.radius *= 3.5 + 0.4 * k as f64;
+        s.mass = s.radius.powi(3);
+    }
+    let dense = lattice_world(3000, 0.4, 1.0, 7).expect("lattice");
+    [(dense, 0.005, 60), (dilute, 0.01, 100)]
+}
+
 /// Relabelling the spheres in space as they drift changes nothing anyone
 /// sees: the same contacts (lower world id first, the same impulse bits) in
 /// the same order and the same final state, bit for bit, as keeping the
@@ -303,21 +317,7 @@ fn record(mut w: World, m: Exact, dt: f64, steps: u64) -> (Vec<[u64; 4]>, World,
 /// few large spheres among them).
 #[test]
 fn renumbering_in_space_changes_nothing_but_labels() {
-    let mut dilute = lattice_world(3000, 0.02, 1.0, 9).expect("lattice");
-    for (k, s) in dilute.spheres.iter_mut().step_by(1000).enumerate() {
-        // 3.5 to 4.3 times the rest: on the second level, clear of the
-        // lattice neighbours.
-        s.radius *= 3.5 + 0.4 * k as f64;
-        s.mass = s.radius.powi(3);
-    }
-    for (w, dt, steps) in [
-        (
-            lattice_world(3000, 0.4, 1.0, 7).expect("lattice"),
-            0.005,
-            60,
-        ),
-        (dilute, 0.01, 100),
-    ] {
+    for (w, dt, steps) in lists_and_cells_scenes() {
         let (kept, w_kept, none) = record(w.clone(), Exact::default(), dt, steps);
         let (moved, w_moved, renumberings) =
             record(w, Exact::default().with_renumbering(true), dt, steps);
@@ -327,6 +327,28 @@ fn renumbering_in_space_changes_nothing_but_labels() {
         assert!(kept.iter().all(|c| c[0] < c[1]));
         assert!(kept == moved, "the contacts differ");
         for (a, b) in w_kept.spheres.iter().zip(&w_moved.spheres) {
+            assert_eq!((a.pos, a.vel), (b.pos, b.vel));
+        }
+    }
+}
+
+/// Prefetching only loads lines early: with it at every count and with it
+/// off, the same contacts in the same order and the same final state, bit
+/// for bit, with neighbour lists (dense) and with cells (dilute, a few large
+/// spheres among them, which take the large spheres' paths).
+#[test]
+fn prefetching_changes_nothing() {
+    for (w, dt, steps) in lists_and_cells_scenes() {
+        let (off, w_off, _) = record(
+            w.clone(),
+            Exact::default().with_prefetching(false),
+            dt,
+            steps,
+        );
+        let (on, w_on, _) = record(w, Exact::default().with_prefetching(true), dt, steps);
+        assert!(off.len() > 10_000, "only {} contacts", off.len());
+        assert!(off == on, "the contacts differ");
+        for (a, b) in w_off.spheres.iter().zip(&w_on.spheres) {
             assert_eq!((a.pos, a.vel), (b.pos, b.vel));
         }
     }

@@ -102,6 +102,25 @@ impl Bodies {
         }
     }
 
+    /// Start loading the bodies of `labels` ([`Label::raw`]s), so a scan
+    /// over them waits for their misses together, not one by one.
+    #[inline(always)]
+    pub fn prefetch(&self, labels: &[u32]) {
+        for &j in labels {
+            if let Some(b) = self.list.get(j as usize) {
+                crate::physics::prefetch::line(b);
+            }
+        }
+    }
+
+    /// Start loading body `j`.
+    #[inline(always)]
+    pub fn prefetch_one(&self, j: Label) {
+        if let Some(b) = self.list.get(j.index()) {
+            crate::physics::prefetch::line(b);
+        }
+    }
+
     /// The bodies, to be put in a new order.
     #[cfg(feature = "experiments")]
     pub fn list_mut(&mut self) -> &mut Vec<Body> {

@@ -129,7 +129,7 @@ impl EventQueue for EightWay {
     }
 
     /// Climbs to the root always, as the binary tree does.
-    #[inline]
+    #[inline(always)]
     fn update(&mut self, i: usize, t: f64) {
         self.set_key(i, t);
         let (mut p, inner) = (i / WAYS, self.start[1]);
@@ -148,7 +148,7 @@ impl EventQueue for EightWay {
     /// Both leaves first, then both climbs a level at a time, so a node
     /// the two paths share is set from both new children, once; the two
     /// paths' reads are independent, so their misses overlap.
-    #[inline]
+    #[inline(always)]
     fn update_two(&mut self, i: usize, ti: f64, j: usize, tj: f64) {
         self.set_key(i, ti);
         self.set_key(j, tj);
@@ -172,6 +172,45 @@ impl EventQueue for EightWay {
             time(w),
             self.ids[self.start[root] - self.start[1]].0[0] as usize,
         )
+    }
+
+    /// The least of the root winner's siblings at every level of its path
+    /// but the two lowest: the earliest event after the root's but for
+    /// those among the winner's own 64 leaves (all of them in a tree of
+    /// 64 or fewer). Any sphere, or a padding leaf, when no other event
+    /// is finite.
+    #[inline]
+    fn runner_up(&self) -> usize {
+        let root = self.levels - 1;
+        let inner = self.start[1];
+        // The lowest levels are skipped: their groups are cold, and the next
+        // event is among the winner's 63 nearest leaves only 63 times in N.
+        let from = if root > 2 { 2 } else { 0 };
+        let mut a = self.ids[self.start[root] - inner].0[0] as usize / WAYS.pow(from as u32);
+        let (mut best, mut who) = (u64::MAX, usize::MAX);
+        for l in from..root {
+            let (g, lane) = (a / WAYS, a % WAYS);
+            let mut keys = self.keys[self.start[l % MAX_LEVELS] + g];
+            keys.0[lane] = u64::MAX;
+            let (k, at) = least(&keys);
+            if k < best {
+                best = k;
+                who = if l == 0 {
+                    g * WAYS + at
+                } else {
+                    self.ids[self.start[l % MAX_LEVELS] - inner + g].0[at] as usize
+                };
+            }
+            a = g;
+        }
+        who
+    }
+
+    #[inline]
+    fn prefetch(&self, i: usize) {
+        if let Some(g) = self.keys.get(i / WAYS) {
+            crate::physics::prefetch::line(g);
+        }
     }
 
     #[inline]
@@ -219,6 +258,36 @@ mod tests {
         );
         assert_eq!(least(&g(|_| 2)), (2, 0));
         assert_eq!(least(&g(|k| u64::from(k + 1 != WAYS) * 4)), (0, WAYS - 1));
+    }
+
+    /// The runner-up's time is the least outside the winner's 64 leaves
+    /// (outside the winner alone when there are 64 or fewer), under random
+    /// updates with ties.
+    #[test]
+    fn runner_up_is_the_next_event_outside_the_winners_leaves() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(4);
+        for n in [2, 9, 64, 65, 100, 600, 5000] {
+            let mut q = EightWay::default();
+            q.reset(n);
+            let mut times = vec![f64::INFINITY; n];
+            for _ in 0..3000 {
+                let i = rng.random_range(0..n);
+                times[i] = f64::from(rng.random_range(0..50_u32));
+                q.update(i, times[i]);
+                let w = q.peek().1;
+                let apart = |k: usize| if n > 64 { k / 64 != w / 64 } else { k != w };
+                let next = (0..n)
+                    .filter(|&k| apart(k))
+                    .map(|k| times[k])
+                    .fold(f64::INFINITY, f64::min);
+                let r = q.runner_up();
+                if next.is_finite() {
+                    assert!(r < n, "{n} spheres: {r}");
+                    assert_eq!(q.time_of(r), next, "{n} spheres");
+                }
+            }
+        }
     }
 
     #[test]

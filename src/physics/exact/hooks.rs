@@ -1,7 +1,8 @@
 //! The knobs tests, benchmarks and examples turn (feature `experiments`,
 //! which the crate's dev-dependency on itself enables; the shipped binary
 //! has none): a smaller event cap, a finer cell grid, renumbering as the
-//! spheres drift ([`super::renumber`]), and an observer of every contact.
+//! spheres drift ([`super::renumber`]), prefetching at any count or none,
+//! and an observer of every contact.
 use super::ids::Label;
 use super::queue::EventQueue;
 use super::{EventDriven, cell_grid};
@@ -33,6 +34,9 @@ pub(super) struct Hooks {
     /// Sort the spheres in space again as they drift (off by default: it
     /// measured slower, see docs/benchmarks.md "exact at scale").
     pub renumbering: bool,
+    /// Prefetch whatever the count (`Some(true)`) or never (`Some(false)`);
+    /// by default from [`super::PREFETCH_FROM`] spheres.
+    pub prefetching: Option<bool>,
     /// Broad-phase events (crossings, relists) at the last spatial sort.
     pub sorted_at: u64,
     observer: Option<Observer>,
@@ -70,6 +74,14 @@ impl<Q: EventQueue> EventDriven<Q> {
     #[must_use]
     pub fn with_renumbering(mut self, on: bool) -> Self {
         self.hooks.renumbering = on;
+        self
+    }
+
+    /// Prefetch at any count (`true`) or never (`false`), for holding the
+    /// two to the same runs and comparing their speed.
+    #[must_use]
+    pub fn with_prefetching(mut self, on: bool) -> Self {
+        self.hooks.prefetching = Some(on);
         self
     }
 

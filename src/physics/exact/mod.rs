@@ -15,6 +15,11 @@
 //!   (`neighbour_lists`); both keep the few spheres far larger than the
 //!   bulk on a second level (`large`), so radii 100x apart stay cheap;
 //! - stale predictions detected by per-sphere collision counts ([`schedule`]);
+//! - from [`PREFETCH_FROM`] spheres, prefetching: while an event is
+//!   processed, the loop starts loading the cells a crossing reads, a
+//!   contact partner's records, the candidates' bodies, and the records of
+//!   the queue's runner-up (the next event's sphere nearly always), so their
+//!   cache misses overlap instead of following one another;
 //! - spheres sorted in space at load (`spatial`; relabelling them again
 //!   as they drift, `renumber`, is an experiment); the world keeps every
 //!   sphere at its id (`ids`: labels and world ids are apart).
@@ -99,6 +104,15 @@ const ORIGIN_SPAN: f64 = 1.0;
 /// rebuilding a list). Measured at N = 4000.
 pub const LISTS_ABOVE_PACKING: f64 = 0.3;
 
+/// From this many spheres on, the event loop prefetches (`prefetch_ahead`):
+/// the model's arrays (about 125 B a sphere dilute, 230 dense) then
+/// outgrow a core's own cache, and every record an event reads is a miss
+/// worth starting early. Below it the prefetches are instructions for
+/// nothing: at 10k they cost up to 15 % (dilute); at 20k they were level
+/// dilute and 13 % faster dense, at 30k and up faster at every packing
+/// (docs/perf-log.md, 2026-12-05).
+pub const PREFETCH_FROM: usize = 20_000;
+
 /// Which broad phase the schedule uses; chosen from the packing fraction at
 /// each rebuild.
 #[derive(Clone, Debug)]
@@ -146,6 +160,8 @@ pub struct EventDriven<Q: EventQueue> {
     /// `World::generation` of the world they were last written to.
     synced_generation: u64,
     valid: bool,
+    /// Whether the loop prefetches ([`PREFETCH_FROM`]).
+    prefetching: bool,
     #[cfg(feature = "experiments")]
     hooks: hooks::Hooks,
     /// Events processed since construction, by kind.
@@ -260,9 +276,18 @@ impl<Q: EventQueue> EventDriven<Q> {
             cells.build(&self.bodies, self.size, self.cells_per_sphere());
             self.broad = Broad::Cells(cells);
         }
+        self.prefetching = n >= PREFETCH_FROM;
+        #[cfg(feature = "experiments")]
+        if let Some(on) = self.hooks.prefetching {
+            self.prefetching = on;
+        }
         self.queue.reset(n);
         for i in self.bodies.labels() {
-            let t = self.predict(i);
+            let t = if self.prefetching {
+                self.predict::<true>(i)
+            } else {
+                self.predict::<false>(i)
+            };
             self.queue.set_leaf(i.index(), t);
         }
         self.queue.rebuild();
@@ -271,7 +296,9 @@ impl<Q: EventQueue> EventDriven<Q> {
 
     /// Sphere `i`'s next event, into its slot; returns its absolute time.
     #[inline]
-    fn predict(&mut self, i: Label) -> f64 {
+    /// `PF`: whether to prefetch ([`PREFETCH_FROM`]; a parameter, so the
+    /// loop has no test for it).
+    fn predict<const PF: bool>(&mut self, i: Label) -> f64 {
         let a = &self.bodies[i];
         match &self.broad {
             Broad::Lists(nl) => {
@@ -281,6 +308,9 @@ impl<Q: EventQueue> EventDriven<Q> {
                 };
                 let t = nl.relist_time(i, a);
                 let mut p = Predictor::new(a, &self.bodies, self.size, t, relist);
+                if PF {
+                    self.prefetch_neighbours(i);
+                }
                 for l in nl.of(i) {
                     p.pair(l.j);
                 }
@@ -292,6 +322,9 @@ impl<Q: EventQueue> EventDriven<Q> {
                 let idle = Event::default();
                 let mut p = Predictor::new(a, &self.bodies, self.size, f64::INFINITY, idle);
                 let n = cells.candidates(i, p.radius(), &mut self.candidates);
+                if PF {
+                    self.bodies.prefetch(&self.candidates[..n]);
+                }
                 for &j in &self.candidates[..n] {
                     if j != i.raw() {
                         p.pair(Label::from_raw(j));
@@ -325,28 +358,31 @@ impl<Q: EventQueue> EventDriven<Q> {
     }
 
     #[inline]
-    fn schedule(&mut self, i: Label) {
-        let t = self.predict(i);
+    fn schedule<const PF: bool>(&mut self, i: Label) {
+        let t = self.predict::<PF>(i);
         self.queue.update(i.index(), t);
     }
 
     /// Cell mode, after sphere `i` crossed as `mask` says: its pending event
     /// still holds unless its partner has moved on; only the new layer of
     /// cells needs checking.
-    fn after_crossing(&mut self, i: Label, mask: u8) {
+    fn after_crossing<const PF: bool>(&mut self, i: Label, mask: u8) {
         let (tp, evp) = self.slots[i.index()].pending();
         if evp.kind == Kind::Pair && self.bodies[evp.partner].count != evp.partner_count {
-            self.schedule(i);
+            self.schedule::<PF>(i);
             return;
         }
         let Broad::Cells(cells) = &self.broad else {
             // Only cells have crossings; any other broad phase predicts anew.
-            self.schedule(i);
+            self.schedule::<PF>(i);
             return;
         };
         let a = &self.bodies[i];
         let mut p = Predictor::resume(a, &self.bodies, tp - a.t, evp);
         let n = cells.new_candidates(i, mask, &mut self.candidates);
+        if PF {
+            self.bodies.prefetch(&self.candidates[..n]);
+        }
         for &j in &self.candidates[..n] {
             p.pair(Label::from_raw(j));
         }
@@ -378,7 +414,7 @@ impl<Q: EventQueue> EventDriven<Q> {
     /// cap stopped it first.
     // Never inlined: profilers count the event loop by this name.
     #[inline(never)]
-    fn run_until(&mut self, target: f64, c: &mut Counters) -> bool {
+    fn run_until<const PF: bool>(&mut self, target: f64, c: &mut Counters) -> bool {
         let cap = self.event_cap();
         let mut done = 0u64;
         loop {
@@ -392,20 +428,27 @@ impl<Q: EventQueue> EventDriven<Q> {
             }
             done += 1;
             let ev = self.slots[i.index()].queued();
+            if PF {
+                self.prefetch_ahead(i, ev);
+            }
             self.bodies[i].advance(t);
             match ev.kind {
                 Kind::Pair => {
                     let j = ev.partner;
                     if self.bodies[j].count != ev.partner_count {
                         self.stats.stale += 1;
-                        self.schedule(i);
+                        self.schedule::<PF>(i);
                         continue;
                     }
                     self.stats.pairs += 1;
                     self.bodies[j].advance(t);
                     self.collide(i, j, c);
-                    let ti = self.predict(i);
-                    let tj = self.predict(j);
+                    if PF {
+                        // Its misses then wait beside `i`'s prediction's.
+                        self.prefetch_neighbours(j);
+                    }
+                    let ti = self.predict::<PF>(i);
+                    let tj = self.predict::<PF>(j);
                     self.queue.update_two(i.index(), ti, j.index(), tj);
                 }
                 Kind::Wall => {
@@ -420,7 +463,7 @@ impl<Q: EventQueue> EventDriven<Q> {
                     b.count = b.count.wrapping_add(1);
                     c.wall_momentum += imp;
                     c.wall_collisions += hits;
-                    self.schedule(i);
+                    self.schedule::<PF>(i);
                 }
                 Kind::Relist => {
                     self.stats.relists += 1;
@@ -428,18 +471,62 @@ impl<Q: EventQueue> EventDriven<Q> {
                         Broad::Lists(nl) => nl.rebuild(i, &self.bodies),
                         Broad::Cells(cells) => cells.rescan(i, &self.bodies[i]),
                     }
-                    self.schedule(i);
+                    self.schedule::<PF>(i);
                 }
                 Kind::Cross => {
                     self.stats.crossings += 1;
                     if let Broad::Cells(cells) = &mut self.broad {
                         cells.cross(i, ev.mask);
                     }
-                    self.after_crossing(i, ev.mask);
+                    self.after_crossing::<PF>(i, ev.mask);
                 }
                 // An idle sphere's time is infinite: it is never popped
                 // before the end of a step, and nothing happens to it.
                 Kind::Idle => {}
+            }
+        }
+    }
+
+    /// Start loading what the loop will read next: the cells a crossing
+    /// of `i` (event `ev`) reads, the records of a contact's partner, and
+    /// those of the sphere whose event is likely next (the queue's
+    /// runner-up), so their cache misses wait together while this event is
+    /// processed.
+    #[inline(always)]
+    fn prefetch_ahead(&self, i: Label, ev: Event) {
+        match (ev.kind, &self.broad) {
+            (Kind::Cross, Broad::Cells(cells)) => cells.prefetch_cross(i, ev.mask),
+            (Kind::Pair, _) => self.prefetch_records(ev.partner.index()),
+            _ => {}
+        }
+        self.prefetch_records(self.queue.runner_up());
+    }
+
+    /// Start loading what predicting `i` reads first: the bodies in its
+    /// neighbour list, or the cells around it.
+    #[inline(always)]
+    fn prefetch_neighbours(&self, i: Label) {
+        match &self.broad {
+            Broad::Lists(nl) => {
+                for l in nl.of(i) {
+                    self.bodies.prefetch_one(l.j);
+                }
+            }
+            Broad::Cells(cells) => cells.prefetch_around(i),
+        }
+    }
+
+    /// Start loading sphere `k`'s records, if `k` is a sphere: its slot,
+    /// body and queue leaf, and what its broad phase reads first.
+    #[inline(always)]
+    fn prefetch_records(&self, k: usize) {
+        if let (Some(slot), Some(body)) = (self.slots.get(k), self.bodies.get(k)) {
+            crate::physics::prefetch::line(slot);
+            crate::physics::prefetch::line(body);
+            self.queue.prefetch(k);
+            match &self.broad {
+                Broad::Cells(cells) => cells.prefetch_place(k),
+                Broad::Lists(nl) => nl.prefetch(k),
             }
         }
     }
@@ -512,7 +599,12 @@ impl<Q: EventQueue + Send> Model for EventDriven<Q> {
                 }
                 self.reschedule_all();
             }
-            if !self.run_until(target, &mut world.counters) {
+            let finished = if self.prefetching {
+                self.run_until::<true>(target, &mut world.counters)
+            } else {
+                self.run_until::<false>(target, &mut world.counters)
+            };
+            if !finished {
                 world.counters.capped_steps += 1;
                 self.fly_all(target, &mut world.counters);
                 self.valid = false;

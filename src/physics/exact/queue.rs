@@ -33,6 +33,13 @@ pub trait EventQueue: Default {
     /// The earliest pending event: time and sphere (time infinite if none).
     /// Mutable, so a queue may sort lazily.
     fn peek(&mut self) -> (f64, usize);
+    /// The sphere whose event is likely next after [`Self::peek`]'s, or
+    /// any index at all: a hint for loading its records early.
+    fn runner_up(&self) -> usize {
+        usize::MAX
+    }
+    /// Start loading what [`Self::update`] of sphere `i` will read first.
+    fn prefetch(&self, _i: usize) {}
     /// Time of sphere `i`'s pending event.
     fn time_of(&self, i: usize) -> f64;
     /// Subtract `shift` from every time (a new time origin).

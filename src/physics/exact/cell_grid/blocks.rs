@@ -176,7 +176,7 @@ impl CellBlocks {
 
     /// Take sphere `i` out of cell `c`, its cell; the cell's last sphere
     /// fills its place (so every cell keeps the order it had).
-    #[inline]
+    #[inline(always)]
     pub fn remove(&mut self, i: Label, c: usize) {
         let s = self.slot[c];
         let i = i.raw();
@@ -233,6 +233,14 @@ impl CellBlocks {
             for j in o {
                 *j = new(*j);
             }
+        }
+    }
+
+    /// Start loading cell `c`'s word.
+    #[inline(always)]
+    pub fn prefetch(&self, c: usize) {
+        if let Some(s) = self.slot.get(c) {
+            crate::physics::prefetch::line(s);
         }
     }
 

@@ -166,6 +166,14 @@ impl CellGrid {
         &self.bigs
     }
 
+    /// Start loading sphere `i`'s place.
+    #[inline(always)]
+    pub fn prefetch_place(&self, i: usize) {
+        if let Some(p) = self.place.get(i) {
+            crate::physics::prefetch::line(p);
+        }
+    }
+
     #[inline]
     pub fn is_big(&self, i: Label) -> bool {
         self.place[i.index()] & BIG != 0
@@ -228,8 +236,44 @@ impl CellGrid {
         (best, ev)
     }
 
-    /// Sphere `i` crosses into the next cell as `mask` says.
+    /// Start loading the cell words a crossing of sphere `i` as `mask` says
+    /// will read: its cell, the next, and the layer the next brings.
     #[inline]
+    pub fn prefetch_cross(&self, i: Label, mask: u8) {
+        let axis = (mask & 3) as usize;
+        if axis == 3 || self.is_big(i) {
+            return;
+        }
+        let q = self.padded;
+        let stride = [1, q, q * q][axis];
+        let c = self.cell_of(i);
+        let to = if mask & 4 != 0 {
+            c + stride
+        } else {
+            c - stride
+        };
+        self.list.prefetch(c);
+        self.list.prefetch(to);
+        let corner = to - self.stencil[0];
+        for &o in &self.layers[mask as usize] {
+            self.list.prefetch(corner + o);
+        }
+    }
+
+    /// Start loading the words of the 27 cells around small sphere `i`.
+    #[inline]
+    pub fn prefetch_around(&self, i: Label) {
+        if self.is_big(i) {
+            return;
+        }
+        let corner = self.cell_of(i) - self.stencil[0];
+        for &o in &self.stencil {
+            self.list.prefetch(corner + o);
+        }
+    }
+
+    /// Sphere `i` crosses into the next cell as `mask` says.
+    #[inline(always)]
     pub fn cross(&mut self, i: Label, mask: u8) {
         let q = self.padded;
         let axis = (mask & 3) as usize;
@@ -331,7 +375,7 @@ impl CellGrid {
     /// padding at the edge of the grid), into `out[..n]`; returns `n`.
     /// Together with its best event over the old neighbourhood, these are
     /// all it could touch (Rapaport's trick: a crossing scans 9 cells, not 27).
-    #[inline]
+    #[inline(always)]
     pub fn new_candidates(&self, i: Label, mask: u8, out: &mut Vec<u32>) -> usize {
         let corner = self.cell_of(i) - self.stencil[0];
         self.list

@@ -391,6 +391,24 @@ impl NeighbourLists {
         self.lists.of(i)
     }
 
+    /// Start loading what predicting sphere `k` reads first: its list's
+    /// word and links, and its list's centre.
+    #[inline(always)]
+    pub fn prefetch(&self, k: usize) {
+        use crate::physics::prefetch::line;
+        if let (Some(w), Some(c)) = (self.lists.len.get(k), self.centre.get(k)) {
+            line(w);
+            line(c);
+            let at = k * self.lists.stride;
+            if let Some(l) = self.lists.flat.get(at) {
+                line(l);
+            }
+            if let Some(l) = self.lists.flat.get(at + self.lists.stride - 1) {
+                line(l);
+            }
+        }
+    }
+
     /// Time from `b.t` until sphere `i` has wandered to the edge of its skin.
     #[inline]
     pub fn relist_time(&self, i: Label, b: &Body) -> f64 {
