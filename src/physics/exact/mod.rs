@@ -363,26 +363,27 @@ impl<Q: EventQueue> EventDriven<Q> {
         self.queue.update(i.index(), t);
     }
 
-    /// Cell mode, after sphere `i` crossed as `mask` says: its pending event
-    /// still holds unless its partner has moved on; only the new layer of
-    /// cells needs checking.
-    fn after_crossing<const PF: bool>(&mut self, i: Label, mask: u8) {
+    /// Cell mode: sphere `i` crosses into the next cell as `mask` says. Its
+    /// pending event still holds unless its partner has moved on; only the
+    /// layer of cells the crossing brings next to it needs checking.
+    fn cross<const PF: bool>(&mut self, i: Label, mask: u8) {
+        let Broad::Cells(cells) = &mut self.broad else {
+            // Only cells have crossings; any other broad phase predicts anew.
+            self.schedule::<PF>(i);
+            return;
+        };
+        let n = cells.next_layer(i, mask, &mut self.candidates);
+        if PF {
+            self.bodies.prefetch(&self.candidates[..n]);
+        }
+        cells.cross(i, mask);
         let (tp, evp) = self.slots[i.index()].pending();
         if evp.kind == Kind::Pair && self.bodies[evp.partner].count != evp.partner_count {
             self.schedule::<PF>(i);
             return;
         }
-        let Broad::Cells(cells) = &self.broad else {
-            // Only cells have crossings; any other broad phase predicts anew.
-            self.schedule::<PF>(i);
-            return;
-        };
         let a = &self.bodies[i];
         let mut p = Predictor::resume(a, &self.bodies, tp - a.t, evp);
-        let n = cells.new_candidates(i, mask, &mut self.candidates);
-        if PF {
-            self.bodies.prefetch(&self.candidates[..n]);
-        }
         for &j in &self.candidates[..n] {
             p.pair(Label::from_raw(j));
         }
@@ -475,10 +476,7 @@ impl<Q: EventQueue> EventDriven<Q> {
                 }
                 Kind::Cross => {
                     self.stats.crossings += 1;
-                    if let Broad::Cells(cells) = &mut self.broad {
-                        cells.cross(i, ev.mask);
-                    }
-                    self.after_crossing::<PF>(i, ev.mask);
+                    self.cross::<PF>(i, ev.mask);
                 }
                 // An idle sphere's time is infinite: it is never popped
                 // before the end of a step, and nothing happens to it.
@@ -488,14 +486,21 @@ impl<Q: EventQueue> EventDriven<Q> {
     }
 
     /// Start loading what the loop will read next: the cells a crossing
-    /// of `i` (event `ev`) reads, the records of a contact's partner, and
-    /// those of the sphere whose event is likely next (the queue's
-    /// runner-up), so their cache misses wait together while this event is
-    /// processed.
+    /// of `i` (event `ev`) reads and its pending partner's body, the
+    /// records of a contact's partner, and those of the sphere whose event
+    /// is likely next (the queue's runner-up), so their cache misses wait
+    /// together while this event is processed.
     #[inline(always)]
     fn prefetch_ahead(&self, i: Label, ev: Event) {
         match (ev.kind, &self.broad) {
-            (Kind::Cross, Broad::Cells(cells)) => cells.prefetch_cross(i, ev.mask),
+            (Kind::Cross, Broad::Cells(cells)) => {
+                cells.prefetch_cross(i, ev.mask);
+                // The crossing checks whether its pending contact still holds.
+                let (_, pending) = self.slots[i.index()].pending();
+                if pending.kind == Kind::Pair {
+                    self.bodies.prefetch_one(pending.partner);
+                }
+            }
             (Kind::Pair, _) => self.prefetch_records(ev.partner.index()),
             _ => {}
         }

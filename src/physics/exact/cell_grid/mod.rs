@@ -236,23 +236,29 @@ impl CellGrid {
         (best, ev)
     }
 
+    /// The cell small sphere `i` crosses into as `mask` says (a crossing's
+    /// mask: axis in bits 0..2, upwards if bit 2).
+    #[inline(always)]
+    fn next_cell(&self, i: Label, mask: u8) -> usize {
+        let q = self.padded;
+        let stride = [1, q, q * q][(mask & 3) as usize];
+        let c = self.cell_of(i);
+        if mask & 4 != 0 {
+            c + stride
+        } else {
+            c - stride
+        }
+    }
+
     /// Start loading the cell words a crossing of sphere `i` as `mask` says
     /// will read: its cell, the next, and the layer the next brings.
     #[inline]
     pub fn prefetch_cross(&self, i: Label, mask: u8) {
-        let axis = (mask & 3) as usize;
-        if axis == 3 || self.is_big(i) {
+        if mask & 3 == 3 || self.is_big(i) {
             return;
         }
-        let q = self.padded;
-        let stride = [1, q, q * q][axis];
-        let c = self.cell_of(i);
-        let to = if mask & 4 != 0 {
-            c + stride
-        } else {
-            c - stride
-        };
-        self.list.prefetch(c);
+        let to = self.next_cell(i, mask);
+        self.list.prefetch(self.cell_of(i));
         self.list.prefetch(to);
         let corner = to - self.stencil[0];
         for &o in &self.layers[mask as usize] {
@@ -275,15 +281,11 @@ impl CellGrid {
     /// Sphere `i` crosses into the next cell as `mask` says.
     #[inline(always)]
     pub fn cross(&mut self, i: Label, mask: u8) {
-        let q = self.padded;
-        let axis = (mask & 3) as usize;
-        let stride = [1, q, q * q][axis];
         let c = self.cell_of(i);
-        let up = mask & 4 != 0;
-        let to = if up { c + stride } else { c - stride };
-        let one = 1 << (AXIS_BITS * axis as u32);
+        let to = self.next_cell(i, mask);
+        let one = 1 << (AXIS_BITS * u32::from(mask & 3));
         let p = &mut self.place[i.index()];
-        *p = if up { *p + one } else { *p - one };
+        *p = if mask & 4 != 0 { *p + one } else { *p - one };
         self.list.move_to(i, c, to);
     }
 
@@ -370,14 +372,17 @@ impl CellGrid {
         }
     }
 
-    /// After a crossing (`mask` as in [`Kind::Cross`]): the spheres in the
-    /// layer of cells that just came next to sphere `i`'s new cell (empty
-    /// padding at the edge of the grid), into `out[..n]`; returns `n`.
-    /// Together with its best event over the old neighbourhood, these are
-    /// all it could touch (Rapaport's trick: a crossing scans 9 cells, not 27).
+    /// Before a crossing (`mask` as in [`Kind::Cross`]): the spheres in the
+    /// layer of cells the crossing brings next to small sphere `i`'s new
+    /// cell (empty padding at the edge of the grid), into `out[..n]`;
+    /// returns `n`. Together with its best event over the old
+    /// neighbourhood, these are all it could touch (Rapaport's trick: a
+    /// crossing scans 9 cells, not 27). The layer holds neither the old
+    /// cell nor the new, so the move changes none of it: gathered first,
+    /// its bodies can load while the move runs.
     #[inline(always)]
-    pub fn new_candidates(&self, i: Label, mask: u8, out: &mut Vec<u32>) -> usize {
-        let corner = self.cell_of(i) - self.stencil[0];
+    pub fn next_layer(&self, i: Label, mask: u8, out: &mut Vec<u32>) -> usize {
+        let corner = self.next_cell(i, mask) - self.stencil[0];
         self.list
             .gather_stencil(corner, &self.layers[mask as usize], out)
     }
