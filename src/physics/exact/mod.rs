@@ -486,9 +486,10 @@ impl<Q: EventQueue> EventDriven<Q> {
     }
 
     /// Start loading what the loop will read next: the cells a crossing
-    /// of `i` (event `ev`) reads and its pending partner's body, the
-    /// records of a contact's partner, and those of the sphere whose event
-    /// is likely next (the queue's runner-up), so their cache misses wait
+    /// of `i` (event `ev`) reads and its pending partner's body; after a
+    /// contact or a wall, what predicting `i` reads first, and the
+    /// partner's records; and the records of the sphere whose event is
+    /// likely next (the queue's runner-up), so their cache misses wait
     /// together while this event is processed.
     #[inline(always)]
     fn prefetch_ahead(&self, i: Label, ev: Event) {
@@ -501,7 +502,11 @@ impl<Q: EventQueue> EventDriven<Q> {
                     self.bodies.prefetch_one(pending.partner);
                 }
             }
-            (Kind::Pair, _) => self.prefetch_records(ev.partner.index()),
+            (Kind::Pair, _) => {
+                self.prefetch_records(ev.partner.index());
+                self.prefetch_neighbours(i);
+            }
+            (Kind::Wall, _) => self.prefetch_neighbours(i),
             _ => {}
         }
         self.prefetch_records(self.queue.runner_up());
