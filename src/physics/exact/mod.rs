@@ -531,7 +531,7 @@ impl<Q: EventQueue> EventDriven<Q> {
     #[inline(always)]
     fn prefetch_records(&self, k: usize) {
         if let (Some(slot), Some(body)) = (self.slots.get(k), self.bodies.get(k)) {
-            crate::physics::prefetch::line(slot);
+            crate::physics::prefetch::record(slot);
             crate::physics::prefetch::line(body);
             self.queue.prefetch(k);
             match &self.broad {

@@ -398,7 +398,7 @@ impl NeighbourLists {
         use crate::physics::prefetch::line;
         if let (Some(w), Some(c)) = (self.lists.len.get(k), self.centre.get(k)) {
             line(w);
-            line(c);
+            crate::physics::prefetch::record(c);
             let at = k * self.lists.stride;
             if let Some(l) = self.lists.flat.get(at) {
                 line(l);
