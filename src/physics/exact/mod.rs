@@ -295,9 +295,9 @@ impl<Q: EventQueue> EventDriven<Q> {
     }
 
     /// Sphere `i`'s next event, into its slot; returns its absolute time.
-    #[inline]
     /// `PF`: whether to prefetch ([`PREFETCH_FROM`]; a parameter, so the
     /// loop has no test for it).
+    #[inline]
     fn predict<const PF: bool>(&mut self, i: Label) -> f64 {
         let a = &self.bodies[i];
         match &self.broad {
