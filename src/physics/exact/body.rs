@@ -107,9 +107,7 @@ impl Bodies {
     #[inline(always)]
     pub fn prefetch(&self, labels: &[u32]) {
         for &j in labels {
-            if let Some(b) = self.list.get(j as usize) {
-                crate::physics::prefetch::line(b);
-            }
+            self.prefetch_one(Label::from_raw(j));
         }
     }
 

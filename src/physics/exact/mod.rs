@@ -307,10 +307,9 @@ impl<Q: EventQueue> EventDriven<Q> {
                     ..Event::default()
                 };
                 let t = nl.relist_time(i, a);
+                // No prefetch here: the loop asked for these bodies as the
+                // event began (a relist has just read them).
                 let mut p = Predictor::new(a, &self.bodies, self.size, t, relist);
-                if PF {
-                    self.prefetch_neighbours(i);
-                }
                 for l in nl.of(i) {
                     p.pair(l.j);
                 }

@@ -395,10 +395,10 @@ impl NeighbourLists {
     /// word and links, and its list's centre.
     #[inline(always)]
     pub fn prefetch(&self, k: usize) {
-        use crate::physics::prefetch::line;
+        use crate::physics::prefetch::{line, record};
         if let (Some(w), Some(c)) = (self.lists.len.get(k), self.centre.get(k)) {
             line(w);
-            crate::physics::prefetch::record(c);
+            record(c);
             let at = k * self.lists.stride;
             if let Some(l) = self.lists.flat.get(at) {
                 line(l);
