@@ -105,7 +105,7 @@ const ORIGIN_SPAN: f64 = 1.0;
 pub const LISTS_ABOVE_PACKING: f64 = 0.3;
 
 /// From this many spheres on, the event loop prefetches (`prefetch_ahead`):
-/// the model's arrays (about 125 B a sphere dilute, 230 dense) then
+/// the model's arrays (about 125 B a sphere dilute, 200 dense) then
 /// outgrow a core's own cache, and every record an event reads is a miss
 /// worth starting early. Below it the prefetches are instructions for
 /// nothing: at 10k they cost up to 15 % (dilute); at 20k they were level

@@ -20,7 +20,7 @@ use super::body::{Bodies, Body};
 use super::ids::{Cell, Label, SpeciesId};
 use super::large::{BIG_FACTOR, split_big, time_to_leave};
 #[cfg(feature = "experiments")]
-use super::renumber::{apply, apply_chunks};
+use super::renumber::apply;
 use crate::physics::huge_pages;
 use chains::CellChains;
 use glam::DVec3;
@@ -35,14 +35,13 @@ const TARGET_NEIGHBOURS: f64 = 12.0;
 /// Relist a little before the skin is used up, so rounding in the lazy
 /// positions can never let a non-neighbour slip into contact.
 const TRIGGER: f64 = 1.0 - 1e-6;
-/// The flat lists' stride is a multiple of this many links, and grows by it
-/// when a list fills. A build counts its lists first and leaves [`HEADROOM`]
-/// links past the longest: at a million dense spheres (longest 18, mean
-/// 13.5) the stride is 24 where a fixed 32 held a third more than that.
-const STRIDE_STEP: usize = 8;
-/// Links past the longest list a build leaves room for, as lists lengthen
-/// with relists.
-const HEADROOM: usize = 4;
+/// Links a list keeps in its sphere's own line: one cache line (64
+/// bytes) a sphere, read whole by every prediction. A list that grows past
+/// it moves out of line until the sphere relists. At a million dense
+/// spheres lists hold 12 to 13.5 links on average and at most 18 (the
+/// lattice start: 1.9 % past 16, 0.01 % once the fluid has melted), where
+/// a stride sized by the longest list took 24 links (docs/benchmarks.md).
+const LINE_LINKS: usize = 16;
 
 /// A list centre with the sphere's species beside it (its radius from the
 /// species table, a few lines every scan shares): 28 bytes, packed, where a
@@ -70,103 +69,81 @@ pub struct Link {
     pub j: Label,
 }
 
-/// Where a sphere's list is kept, as its word in `Lists::len` says: in the
-/// flat array with this length (a bulk sphere), or the `Big(k)`th of the
-/// large spheres' own lists (the word's top bit set). One word a sphere,
-/// read by every look-up.
+/// A sphere's list when it fits its line: the links, the first
+/// `len` of them in use; aligned, so a list is one cache line.
+#[derive(Clone, Copy, Debug, Default)]
+#[repr(C, align(64))]
+struct Line([Link; LINE_LINKS]);
+
+/// Where a sphere's list is kept, as its word in `Lists::len` says: in its
+/// own [`Line`] with this length, or the `Out(k)`th of the lists kept out
+/// of line (one past [`LINE_LINKS`] links, or a large sphere's). One word a
+/// sphere, read by every look-up.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Home {
-    Flat(usize),
-    Big(usize),
+    Line(usize),
+    Out(usize),
 }
 
-/// The top bit of a `Lists::len` word: a large sphere's list.
-const BIG: u32 = 1 << 31;
+/// The top bit of a `Lists::len` word: the list is out of line.
+const OUT: u32 = 1 << 31;
+/// The next bit: the sphere is large (its list always out of line, itself
+/// in no cell).
+const LARGE: u32 = 1 << 30;
 
 impl Home {
     #[inline(always)]
     fn of(word: u32) -> Home {
-        if word & BIG == 0 {
-            Home::Flat(word as usize)
+        if word & OUT == 0 {
+            Home::Line(word as usize)
         } else {
-            Home::Big((word & !BIG) as usize)
-        }
-    }
-
-    /// The length of a flat list (none for a large sphere's).
-    #[inline(always)]
-    fn flat_len(word: u32) -> Option<usize> {
-        match Home::of(word) {
-            Home::Flat(len) => Some(len),
-            Home::Big(_) => None,
+            Home::Out((word & !(OUT | LARGE)) as usize)
         }
     }
 }
 
-/// Neighbour lists of the bulk spheres in one flat array with one stride
-/// (no pointer per list; the stride grows, in place, if a list fills),
-/// and separate growable lists for the few large spheres, whose neighbours
-/// may number thousands.
+/// Neighbour lists: each sphere's in its own cache line while it fits
+/// (nearly all), the rest (a list that outgrew its line, and the few
+/// large spheres', which may hold thousands) in growable lists of their
+/// own.
 #[derive(Clone, Debug, Default)]
 struct Lists {
-    stride: usize,
-    flat: Vec<Link>,
-    /// Each sphere's [`Home`] as a word: its flat list's length, or
-    /// [`BIG`] and its place in `big`.
+    lines: Vec<Line>,
+    /// Each sphere's [`Home`] as a word: its line's length, or [`OUT`]
+    /// (and [`LARGE`]) and its place in `out`.
     len: Vec<u32>,
-    big: Vec<Vec<Link>>,
+    out: Vec<Vec<Link>>,
+    /// Places in `out` whose list went back in line, for the next one out.
+    free: Vec<u32>,
 }
 
 impl Lists {
-    /// Empty lists for `n` spheres, all in the flat array at `stride`.
-    fn reset(&mut self, n: usize, stride: usize) {
+    /// Empty lists for `n` spheres, all in line. The old lines go first, so
+    /// two arrays are never held at once.
+    fn reset(&mut self, n: usize) {
         huge_pages::refill(&mut self.len, n, 0);
-        self.big.clear();
-        self.set_stride(stride);
-    }
-
-    /// A new flat array at `stride`, every list emptied. The old one goes
-    /// first, so the two are never held at once.
-    fn set_stride(&mut self, stride: usize) {
-        self.stride = stride;
-        self.flat = Vec::new();
-        self.flat = huge_pages::filled(self.len.len() * stride, Link::default());
-        for w in self
-            .len
-            .iter_mut()
-            .filter(|w| Home::flat_len(**w).is_some())
-        {
-            *w = 0;
-        }
-    }
-
-    /// Count a pair found by a build's first pass (in the lengths).
-    #[inline]
-    fn count(&mut self, i: Label, j: Label) {
-        for k in [i, j] {
-            if !self.is_big(k) {
-                self.len[k.index()] += 1;
-            }
-        }
-    }
-
-    /// After a build's counting pass: a stride with room for [`HEADROOM`]
-    /// more links than the longest list, every list empty again.
-    fn fit_counts(&mut self) {
-        let longest = self.len.iter().filter_map(|&w| Home::flat_len(w)).max();
-        let longest = longest.unwrap_or(0);
-        self.set_stride((longest + HEADROOM).next_multiple_of(STRIDE_STEP));
+        self.lines = Vec::new();
+        self.lines = huge_pages::filled(n, Line::default());
+        self.out.clear();
+        self.free.clear();
     }
 
     /// Whether `i` is a large sphere (its list growable, itself in no cell).
     #[inline]
     fn is_big(&self, i: Label) -> bool {
-        Home::flat_len(self.len[i.index()]).is_none()
+        self.len[i.index()] & LARGE != 0
     }
 
     fn make_big(&mut self, i: Label) {
-        self.len[i.index()] = BIG | self.big.len() as u32;
-        self.big.push(Vec::new());
+        self.len[i.index()] = OUT | LARGE | self.take_out();
+    }
+
+    /// A free place in `out`, its list empty.
+    fn take_out(&mut self) -> u32 {
+        self.free.pop().unwrap_or_else(|| {
+            self.out.push(Vec::new());
+            (self.out.len() - 1) as u32
+        })
     }
 
     #[inline(always)]
@@ -177,39 +154,48 @@ impl Lists {
     #[inline]
     fn of(&self, i: Label) -> &[Link] {
         match self.home(i) {
-            Home::Flat(len) => &self.flat[i.index() * self.stride..][..len],
-            Home::Big(k) => &self.big[k],
+            Home::Line(len) => &self.lines[i.index()].0[..len],
+            Home::Out(k) => &self.out[k],
         }
     }
 
     #[inline]
     fn of_mut(&mut self, i: Label) -> &mut [Link] {
         match self.home(i) {
-            Home::Flat(len) => &mut self.flat[i.index() * self.stride..][..len],
-            Home::Big(k) => &mut self.big[k],
+            Home::Line(len) => &mut self.lines[i.index()].0[..len],
+            Home::Out(k) => &mut self.out[k],
         }
     }
 
     #[inline]
     fn push(&mut self, i: Label, l: Link) {
         match self.home(i) {
-            Home::Flat(len) => {
-                if len == self.stride {
-                    self.grow();
-                }
-                self.flat[i.index() * self.stride + len] = l;
+            Home::Line(len) if len < LINE_LINKS => {
+                self.lines[i.index()].0[len] = l;
                 self.len[i.index()] += 1;
             }
-            Home::Big(k) => self.big[k].push(l),
+            Home::Line(_) => self.move_out(i, l),
+            Home::Out(k) => self.out[k].push(l),
         }
+    }
+
+    /// `i`'s full line, then `l`, in a list out of line, in order.
+    #[cold]
+    fn move_out(&mut self, i: Label, l: Link) {
+        let k = self.take_out();
+        let list = &mut self.out[k as usize];
+        list.reserve_exact(2 * LINE_LINKS);
+        list.extend_from_slice(&self.lines[i.index()].0);
+        list.push(l);
+        self.len[i.index()] = OUT | k;
     }
 
     #[inline]
     fn pop(&mut self, i: Label) {
         match self.home(i) {
-            Home::Flat(_) => self.len[i.index()] -= 1,
-            Home::Big(k) => {
-                self.big[k].pop();
+            Home::Line(_) => self.len[i.index()] -= 1,
+            Home::Out(k) => {
+                self.out[k].pop();
             }
         }
     }
@@ -221,7 +207,8 @@ impl Lists {
         self.push(j, Link { j: i });
     }
 
-    /// Remove `i` from all its neighbours' lists and empty its own.
+    /// Remove `i` from all its neighbours' lists and empty its own (back in
+    /// its line, unless it is large).
     fn unlink_all(&mut self, i: Label) {
         for k in 0..self.of(i).len() {
             let j = self.of(i)[k].j;
@@ -237,8 +224,13 @@ impl Lists {
             }
         }
         match self.home(i) {
-            Home::Flat(_) => self.len[i.index()] = 0,
-            Home::Big(k) => self.big[k].clear(),
+            Home::Line(_) => self.len[i.index()] = 0,
+            Home::Out(k) if self.is_big(i) => self.out[k].clear(),
+            Home::Out(k) => {
+                self.out[k] = Vec::new();
+                self.free.push(k as u32);
+                self.len[i.index()] = 0;
+            }
         }
     }
 
@@ -246,38 +238,18 @@ impl Lists {
     /// every list keeps its order.
     #[cfg(feature = "experiments")]
     fn relabel(&mut self, perm: &[Label], inv: &[Label]) {
-        apply_chunks(&mut self.flat, self.stride, perm);
+        apply(&mut self.lines, perm);
         apply(&mut self.len, perm);
-        for i in 0..self.len.len() {
-            if !self.is_big(Label::at(i)) {
-                for l in self.of_mut(Label::at(i)) {
+        for (line, &w) in self.lines.iter_mut().zip(&self.len) {
+            if let Home::Line(len) = Home::of(w) {
+                for l in &mut line.0[..len] {
                     l.j = inv[l.j.index()];
                 }
             }
         }
-        for l in self.big.iter_mut().flatten() {
+        for l in self.out.iter_mut().flatten() {
             l.j = inv[l.j.index()];
         }
-    }
-
-    fn grow(&mut self) {
-        self.grow_to(self.stride + STRIDE_STEP);
-    }
-
-    /// A wider stride, in place: the buffer grows (a large one by remapping
-    /// its pages, not by a copy, so the peak is the new size), then every
-    /// list moves to its new place, the last first, so none is overwritten
-    /// before it has moved. Each list keeps its order.
-    fn grow_to(&mut self, stride: usize) {
-        let (old, n) = (self.stride, self.len.len());
-        huge_pages::reserve(&mut self.flat, n * stride);
-        self.flat.resize(n * stride, Link::default());
-        for (i, &w) in self.len.iter().enumerate().rev() {
-            if let Some(len) = Home::flat_len(w) {
-                self.flat.copy_within(i * old..i * old + len, i * stride);
-            }
-        }
-        self.stride = stride;
     }
 }
 
@@ -298,13 +270,14 @@ impl NeighbourLists {
     /// Bytes held on the heap.
     pub fn heap_bytes(&self) -> usize {
         let l = &self.lists;
-        let big: usize = l.big.iter().map(|b| b.capacity() * size_of::<Link>()).sum();
+        let out: usize = l.out.iter().map(|b| b.capacity() * size_of::<Link>()).sum();
         self.centre.capacity() * size_of::<Centre>()
-            + l.flat.capacity() * size_of::<Link>()
+            + l.lines.capacity() * size_of::<Line>()
             + l.len.capacity() * 4
             + self.bigs.capacity() * size_of::<Label>()
-            + l.big.capacity() * size_of::<Vec<Link>>()
-            + big
+            + l.out.capacity() * size_of::<Vec<Link>>()
+            + out
+            + l.free.capacity() * 4
             + self.cells.heap_bytes()
     }
 
@@ -317,7 +290,7 @@ impl NeighbourLists {
             pos: b.pos.to_array(),
             species: b.species,
         }));
-        self.lists.reset(n, 0);
+        self.lists.reset(n);
         self.bigs.clear();
         self.cells.reset(n, 0);
         if n == 0 {
@@ -351,14 +324,8 @@ impl NeighbourLists {
                 self.cells.insert(i, self.cell_of(b.pos));
             }
         }
-        // Count, size the flat array once, then link: growing it while
-        // linking would hold the old array beside the new.
         for i in bodies.labels() {
-            self.scan(i, bodies, |j| j > i, Lists::count);
-        }
-        self.lists.fit_counts();
-        for i in bodies.labels() {
-            self.scan(i, bodies, |j| j > i, Lists::link);
+            self.scan(i, bodies, |j| j > i);
         }
     }
 
@@ -371,7 +338,7 @@ impl NeighbourLists {
             self.cells.move_to(i, from, self.cell_of(bodies[i].pos));
         }
         self.centre[i.index()].pos = bodies[i].pos.to_array();
-        self.scan(i, bodies, |j| j != i, Lists::link);
+        self.scan(i, bodies, |j| j != i);
     }
 
     /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
@@ -392,20 +359,18 @@ impl NeighbourLists {
     }
 
     /// Start loading what predicting sphere `k` reads first: its list's
-    /// word and links, and its list's centre.
+    /// word and line, and its list's centre.
     #[inline(always)]
     pub fn prefetch(&self, k: usize) {
         use crate::physics::prefetch::{line, record};
-        if let (Some(w), Some(c)) = (self.lists.len.get(k), self.centre.get(k)) {
+        if let (Some(w), Some(c), Some(l)) = (
+            self.lists.len.get(k),
+            self.centre.get(k),
+            self.lists.lines.get(k),
+        ) {
             line(w);
             record(c);
-            let at = k * self.lists.stride;
-            if let Some(l) = self.lists.flat.get(at) {
-                line(l);
-            }
-            if let Some(l) = self.lists.flat.get(at + self.lists.stride - 1) {
-                line(l);
-            }
+            line(l);
         }
     }
 
@@ -419,16 +384,9 @@ impl NeighbourLists {
         )
     }
 
-    /// Find the neighbours `j` of `i` (with `want(j)`) and `found(i, j)`
-    /// each pair: link it, or count it.
+    /// Find the neighbours `j` of `i` (with `want(j)`) and link each pair.
     #[allow(clippy::excessive_nesting)] // a box of cells, z, y, x, each cell's spheres in a closure
-    fn scan(
-        &mut self,
-        i: Label,
-        bodies: &Bodies,
-        want: impl Fn(Label) -> bool,
-        found: impl Fn(&mut Lists, Label, Label),
-    ) {
+    fn scan(&mut self, i: Label, bodies: &Bodies, want: impl Fn(Label) -> bool) {
         let ci = self.centre[i.index()].pos();
         let ri = bodies.radius(i) + 2.0 * self.skin;
         let test = |j: Label, centre: &[Centre], lists: &mut Lists| {
@@ -438,7 +396,7 @@ impl NeighbourLists {
             let c = centre[j.index()];
             let s = ri + bodies.radius_of_species(c.species);
             if (ci - c.pos()).length_squared() < s * s {
-                found(lists, i, j);
+                lists.link(i, j);
             }
         };
         let big = self.lists.is_big(i);
@@ -486,12 +444,13 @@ impl NeighbourLists {
 
 #[cfg(test)]
 mod tests {
-    use super::{HEADROOM, Label, Link, Lists, STRIDE_STEP};
+    use super::{Home, LINE_LINKS, Label, Line, Link, Lists};
 
     #[test]
-    fn a_link_is_the_neighbour_alone() {
+    fn a_link_is_the_neighbour_alone_and_a_line_one_cache_line() {
         // Most of the memory of `exact` at a million dense spheres.
         assert_eq!(size_of::<Link>(), 4);
+        assert_eq!((size_of::<Line>(), align_of::<Line>()), (64, 64));
     }
 
     #[test]
@@ -499,15 +458,18 @@ mod tests {
         assert_eq!(size_of::<super::Centre>(), 28);
     }
 
+    fn ids(l: &Lists, i: usize) -> Vec<usize> {
+        l.of(Label::at(i)).iter().map(|k| k.j.index()).collect()
+    }
+
     #[test]
     fn unlinking_fills_each_hole_with_the_lists_last_entry() {
         let mut l = Lists::default();
-        l.reset(5, STRIDE_STEP);
+        l.reset(5);
         let at = Label::at;
         for (i, j) in [(0, 1), (2, 1), (1, 3), (4, 1), (0, 3)] {
             l.link(at(i), at(j));
         }
-        let ids = |l: &Lists, i| l.of(at(i)).iter().map(|k| k.j.index()).collect::<Vec<_>>();
         assert_eq!(ids(&l, 1), [0, 2, 3, 4]);
         l.unlink_all(at(0));
         // 0 left 1's list (4, its last, took the hole) and 3's.
@@ -520,48 +482,47 @@ mod tests {
         }
     }
 
-    /// A list past the stride widens it in place: every list keeps its
-    /// entries in order. A count sizes the stride past the longest list.
+    /// A list past its line moves out of line in order, keeps working there
+    /// (holes filled by the last entry, as in line), and goes back in line
+    /// when its sphere relists; its place out of line is taken by the next.
+    /// A large sphere's list stays out of line and the sphere large.
     #[test]
-    fn a_full_list_widens_the_stride_and_keeps_every_list() {
+    fn a_list_past_its_line_moves_out_and_back_in_order() {
+        let n = 40;
         let mut l = Lists::default();
-        let n = 30;
-        l.reset(n, STRIDE_STEP);
+        l.reset(n);
         let at = Label::at;
-        // Sphere 25 is large: its list is its own, whatever the stride.
-        l.make_big(at(25));
-        l.link(at(25), at(1));
-        // Sphere 0 neighbours 1..=20 (past two strides); 1..=3 also
-        // neighbour 29, and 29 is last in memory, so its list moves first.
-        for j in 1..=20 {
+        l.make_big(at(39));
+        l.link(at(39), at(1));
+        let extra = LINE_LINKS + 4;
+        for j in 1..=extra {
             l.link(at(0), at(j));
         }
-        for j in 1..=3 {
-            l.link(at(29), at(j));
+        assert_eq!(ids(&l, 0), (1..=extra).collect::<Vec<_>>());
+        assert!(matches!(l.home(at(0)), Home::Out(_)) && !l.is_big(at(0)));
+        assert_eq!(ids(&l, 1), [39, 0]);
+        // Sphere 5 leaves 0's list: 0's last entry takes its hole.
+        l.unlink_all(at(5));
+        let mut want: Vec<usize> = (1..=extra).collect();
+        want[4] = extra;
+        want.pop();
+        assert_eq!(ids(&l, 0), want);
+        l.unlink_all(at(0));
+        assert_eq!(l.home(at(0)), Home::Line(0));
+        assert_eq!(l.free.len(), 1);
+        for j in 1..=extra {
+            assert!(!ids(&l, j).contains(&0), "0 still in {j}'s list");
         }
-        assert_eq!(l.stride, 3 * STRIDE_STEP);
-        let ids = |l: &Lists, i| l.of(at(i)).iter().map(|k| k.j.index()).collect::<Vec<_>>();
-        assert_eq!(ids(&l, 0), (1..=20).collect::<Vec<_>>());
-        assert_eq!(ids(&l, 29), [1, 2, 3]);
-        assert_eq!(ids(&l, 1), [25, 0, 29]);
-        for j in 2..=3 {
-            assert_eq!(ids(&l, j), [0, 29], "list of {j}");
+        // Sphere 2 outgrows its line: it takes the freed place.
+        for j in 3..=3 + LINE_LINKS {
+            l.link(at(2), at(j));
         }
-        assert!(l.is_big(at(25)) && !l.is_big(at(0)));
-        assert_eq!(ids(&l, 25), [1]);
-        let mut c = Lists::default();
-        c.reset(n, 0);
-        c.make_big(at(25));
-        for j in 1..=20 {
-            c.count(at(0), at(j));
-            // A large sphere's many neighbours do not size the stride.
-            c.count(at(25), at(j));
-        }
-        c.fit_counts();
-        assert_eq!(c.stride, (20 + HEADROOM).next_multiple_of(STRIDE_STEP));
-        assert_eq!(ids(&c, 0), Vec::<usize>::new());
-        assert!(c.is_big(at(25)));
-        c.link(at(25), at(4));
-        assert_eq!(ids(&c, 25), [4]);
+        assert!(matches!(l.home(at(2)), Home::Out(_)) && l.free.is_empty());
+        assert_eq!(ids(&l, 2), (3..=3 + LINE_LINKS).collect::<Vec<_>>());
+        assert!(l.is_big(at(39)) && matches!(l.home(at(39)), Home::Out(_)));
+        assert_eq!(ids(&l, 39), [1]);
+        l.unlink_all(at(39));
+        assert!(l.is_big(at(39)) && ids(&l, 39).is_empty());
+        assert_eq!(ids(&l, 1), Vec::<usize>::new());
     }
 }
