@@ -143,10 +143,14 @@ pub struct EventDriven<Q: EventQueue> {
     /// by cell when loaded), so neighbours sit close in memory and a
     /// prediction touches few cache lines.
     order: Vec<WorldId>,
-    /// Each sphere's event; in cell mode its best contact or wall event
-    /// (absolute time), kept apart from its crossing so a crossing rescans
-    /// only new cells, and which of the two the queue holds.
+    /// Cell mode: each sphere's best contact or wall event and its
+    /// (absolute) time, kept apart from its crossing so a crossing rescans
+    /// only new cells, and which of the two the queue holds. Empty with
+    /// neighbour lists.
     slots: Vec<Slot>,
+    /// With neighbour lists: each sphere's event, whose time the queue
+    /// alone keeps (8 bytes a sphere less than a slot). Empty in cell mode.
+    events: Vec<Event>,
     queue: Q,
     broad: Broad,
     /// Scratch for the candidates a prediction gathers: labels, as the
@@ -196,6 +200,7 @@ impl<Q: EventQueue> EventDriven<Q> {
             + self.order.capacity() * size_of::<WorldId>()
             + self.candidates.capacity() * size_of::<u32>()
             + self.slots.capacity() * size_of::<Slot>()
+            + self.events.capacity() * size_of::<Event>()
             + self.queue.heap_bytes()
             + broad
     }
@@ -259,9 +264,9 @@ impl<Q: EventQueue> EventDriven<Q> {
         for b in self.bodies.iter_mut() {
             b.count = 0;
         }
-        super::huge_pages::refill(&mut self.slots, n, Slot::default());
-        // The old broad phase goes first, so a rebuild never holds two.
+        // The old broad phase and events go first, so a rebuild never holds two.
         self.broad = Broad::default();
+        (self.slots, self.events) = (Vec::new(), Vec::new());
         let filled: f64 = self
             .bodies
             .iter()
@@ -271,7 +276,9 @@ impl<Q: EventQueue> EventDriven<Q> {
             let mut nl = Box::<NeighbourLists>::default();
             nl.build(&self.bodies, self.size);
             self.broad = Broad::Lists(nl);
+            self.events = super::huge_pages::filled(n, Event::default());
         } else {
+            self.slots = super::huge_pages::filled(n, Slot::default());
             let mut cells = Box::<CellGrid>::default();
             cells.build(&self.bodies, self.size, self.cells_per_sphere());
             self.broad = Broad::Cells(cells);
@@ -314,7 +321,7 @@ impl<Q: EventQueue> EventDriven<Q> {
                     p.pair(l.j);
                 }
                 let (t, ev) = p.finish();
-                self.slots[i.index()] = Slot { t, ev };
+                self.events[i.index()] = ev;
                 t
             }
             Broad::Cells(cells) => {
@@ -330,30 +337,11 @@ impl<Q: EventQueue> EventDriven<Q> {
                     }
                 }
                 let (t, ev) = p.finish();
-                self.slots[i.index()] = Slot { t, ev };
-                self.with_crossing(i)
+                let slot = &mut self.slots[i.index()];
+                *slot = Slot { t, ev };
+                with_crossing(cells, slot, i, a)
             }
         }
-    }
-
-    /// The earlier of the pending event and the next crossing (the crossing
-    /// first on a tie), marked in the slot; returns its time. Only cells
-    /// have crossings: with neighbour lists the pending event stands.
-    #[inline]
-    fn with_crossing(&mut self, i: Label) -> f64 {
-        let Broad::Cells(cells) = &self.broad else {
-            return self.slots[i.index()].t;
-        };
-        let a = &self.bodies[i];
-        let (tc, ev) = cells.next_event(i, a);
-        let tc = a.t + tc;
-        let slot = &mut self.slots[i.index()];
-        let tp = slot.t;
-        // By index: which comes first is random, and a branch on it
-        // mispredicted a third of the time.
-        let first = usize::from(tc <= tp);
-        slot.ev.queued = [Queued::PENDING, Queued::broad(&ev)][first];
-        [tp, tc][first]
     }
 
     #[inline]
@@ -387,8 +375,9 @@ impl<Q: EventQueue> EventDriven<Q> {
             p.pair(Label::from_raw(j));
         }
         let (t, ev) = p.finish();
-        self.slots[i.index()] = Slot { t, ev };
-        let t = self.with_crossing(i);
+        let slot = &mut self.slots[i.index()];
+        *slot = Slot { t, ev };
+        let t = with_crossing(cells, slot, i, a);
         self.queue.update(i.index(), t);
     }
 
@@ -403,11 +392,20 @@ impl<Q: EventQueue> EventDriven<Q> {
             b.t = 0.0;
         }
         self.queue.shift(now);
-        // Only cell mode keeps times in the slots; lists' are unused.
+        // Only cell mode keeps times in the slots (lists have none).
         for p in &mut self.slots {
             p.t -= now;
         }
         self.origin = world_time;
+    }
+
+    /// The event the queue holds for sphere `i`.
+    #[inline(always)]
+    fn queued(&self, i: Label) -> Event {
+        match self.broad {
+            Broad::Lists(_) => self.events[i.index()],
+            Broad::Cells(_) => self.slots[i.index()].queued(),
+        }
     }
 
     /// Process every event up to internal time `target`. Returns false if the
@@ -427,7 +425,7 @@ impl<Q: EventQueue> EventDriven<Q> {
                 return false;
             }
             done += 1;
-            let ev = self.slots[i.index()].queued();
+            let ev = self.queued(i);
             if PF {
                 self.prefetch_ahead(i, ev);
             }
@@ -529,13 +527,23 @@ impl<Q: EventQueue> EventDriven<Q> {
     /// body and queue leaf, and what its broad phase reads first.
     #[inline(always)]
     fn prefetch_records(&self, k: usize) {
-        if let (Some(slot), Some(body)) = (self.slots.get(k), self.bodies.get(k)) {
-            crate::physics::prefetch::record(slot);
-            crate::physics::prefetch::line(body);
+        use crate::physics::prefetch::{line, record};
+        if let Some(body) = self.bodies.get(k) {
+            line(body);
             self.queue.prefetch(k);
             match &self.broad {
-                Broad::Cells(cells) => cells.prefetch_place(k),
-                Broad::Lists(nl) => nl.prefetch(k),
+                Broad::Cells(cells) => {
+                    if let Some(slot) = self.slots.get(k) {
+                        record(slot);
+                    }
+                    cells.prefetch_place(k);
+                }
+                Broad::Lists(nl) => {
+                    if let Some(ev) = self.events.get(k) {
+                        record(ev);
+                    }
+                    nl.prefetch(k);
+                }
             }
         }
     }
@@ -631,6 +639,21 @@ impl<Q: EventQueue + Send> Model for EventDriven<Q> {
         }
         Some(self.deepest_overlap(exec))
     }
+}
+
+/// Cell mode: the earlier of sphere `i`'s pending event (in `slot`) and
+/// its next crossing (the crossing first on a tie), marked in the slot;
+/// returns its time.
+#[inline]
+fn with_crossing(cells: &CellGrid, slot: &mut Slot, i: Label, a: &body::Body) -> f64 {
+    let (tc, ev) = cells.next_event(i, a);
+    let tc = a.t + tc;
+    let tp = slot.t;
+    // By index: which comes first is random, and a branch on it
+    // mispredicted a third of the time.
+    let first = usize::from(tc <= tp);
+    slot.ev.queued = [Queued::PENDING, Queued::broad(&ev)][first];
+    [tp, tc][first]
 }
 
 /// A sphere at a wall event, put on the walls of the axes it hits exactly:

@@ -84,11 +84,20 @@ impl<Q: EventQueue> EventDriven<Q> {
             .collect();
         apply(self.bodies.list_mut(), &perm);
         apply(&mut self.order, &perm);
-        apply(&mut self.slots, &perm);
+        // One of the two is empty: slots in cell mode, events with lists.
+        if !self.slots.is_empty() {
+            apply(&mut self.slots, &perm);
+        }
         for slot in &mut self.slots {
             let mut ev = slot.ev;
             relabel(&mut ev, &inv);
             slot.ev = ev;
+        }
+        if !self.events.is_empty() {
+            apply(&mut self.events, &perm);
+        }
+        for ev in &mut self.events {
+            relabel(ev, &inv);
         }
         match &mut self.broad {
             Broad::Lists(nl) => nl.relabel(&perm, &inv),

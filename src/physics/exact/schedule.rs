@@ -78,10 +78,11 @@ impl Queued {
     }
 }
 
-/// What the loop keeps of a sphere's prediction, 20 bytes: its best event
-/// other than a crossing and that event's absolute time (cell mode; lists
-/// keep the time in the queue alone), and whether the next crossing comes
-/// first ([`Event::queued`]).
+/// What the loop keeps of a sphere's prediction in cell mode, 20 bytes:
+/// its best event other than a crossing and that event's absolute time, and
+/// whether the next crossing comes first ([`Event::queued`]). With
+/// neighbour lists the loop keeps the [`Event`] alone: its time is the
+/// queue's.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, packed(4))]
 pub struct Slot {
