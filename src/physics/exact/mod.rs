@@ -353,7 +353,7 @@ impl<Q: EventQueue> EventDriven<Q> {
     /// Cell mode: sphere `i` crosses into the next cell as `mask` says. Its
     /// pending event still holds unless its partner has moved on; only the
     /// layer of cells the crossing brings next to it needs checking.
-    fn cross<const PF: bool>(&mut self, i: Label, mask: u8) {
+    fn cross<const PF: bool>(&mut self, i: Label, mask: u8, next: usize) {
         let Broad::Cells(cells) = &mut self.broad else {
             // Only cells have crossings; any other broad phase predicts anew.
             self.schedule::<PF>(i);
@@ -364,6 +364,9 @@ impl<Q: EventQueue> EventDriven<Q> {
             self.bodies.prefetch(&self.candidates[..n]);
         }
         cells.cross(i, mask);
+        if PF {
+            prefetch_next_crossing(cells, &self.slots, next);
+        }
         let (tp, evp) = self.slots[i.index()].pending();
         if evp.kind == Kind::Pair && self.bodies[evp.partner].count != evp.partner_count {
             self.schedule::<PF>(i);
@@ -426,9 +429,12 @@ impl<Q: EventQueue> EventDriven<Q> {
             }
             done += 1;
             let ev = self.queued(i);
-            if PF {
-                self.prefetch_ahead(i, ev);
-            }
+            // The sphere whose event is likely next (none without prefetching).
+            let next = if PF {
+                self.prefetch_ahead(i, ev)
+            } else {
+                usize::MAX
+            };
             self.bodies[i].advance(t);
             match ev.kind {
                 Kind::Pair => {
@@ -473,7 +479,7 @@ impl<Q: EventQueue> EventDriven<Q> {
                 }
                 Kind::Cross => {
                     self.stats.crossings += 1;
-                    self.cross::<PF>(i, ev.mask);
+                    self.cross::<PF>(i, ev.mask, next);
                 }
                 // An idle sphere's time is infinite: it is never popped
                 // before the end of a step, and nothing happens to it.
@@ -487,9 +493,11 @@ impl<Q: EventQueue> EventDriven<Q> {
     /// contact or a wall, what predicting `i` reads first, and the
     /// partner's records; and the records of the sphere whose event is
     /// likely next (the queue's runner-up), so their cache misses wait
-    /// together while this event is processed.
+    /// together while this event is processed. Returns the runner-up, for
+    /// a crossing to prefetch for it part-way through
+    /// ([`prefetch_next_crossing`]).
     #[inline(always)]
-    fn prefetch_ahead(&self, i: Label, ev: Event) {
+    fn prefetch_ahead(&self, i: Label, ev: Event) -> usize {
         match (ev.kind, &self.broad) {
             (Kind::Cross, Broad::Cells(cells)) => {
                 cells.prefetch_cross(i, ev.mask);
@@ -506,7 +514,9 @@ impl<Q: EventQueue> EventDriven<Q> {
             (Kind::Wall, _) => self.prefetch_neighbours(i),
             _ => {}
         }
-        self.prefetch_records(self.queue.runner_up());
+        let next = self.queue.runner_up();
+        self.prefetch_records(next);
+        next
     }
 
     /// Start loading what predicting `i` reads first: the bodies in its
@@ -638,6 +648,21 @@ impl<Q: EventQueue + Send> Model for EventDriven<Q> {
             self.load(world);
         }
         Some(self.deepest_overlap(exec))
+    }
+}
+
+/// Cell mode: if sphere `next`'s queued event is a crossing, start loading
+/// the cells it will read. Called part-way through an event: `next`'s slot
+/// was asked for as the event began, and has had the event's first misses
+/// to arrive, so the crossing's cells load while the rest of the event
+/// runs, a whole event before they are read.
+#[inline(always)]
+fn prefetch_next_crossing(cells: &CellGrid, slots: &[Slot], next: usize) {
+    if let Some(s) = slots.get(next) {
+        let ev = s.ev.queued;
+        if ev.is_broad() && ev.event().kind == Kind::Cross {
+            cells.prefetch_cross(Label::at(next), ev.event().mask);
+        }
     }
 }
 
