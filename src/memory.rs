@@ -5,14 +5,14 @@ use crate::physics::ModelKind;
 
 /// Peak bytes a sphere costs while a model steps headless (`bench`), with a
 /// quarter for margin (peak RSS at a million spheres less the empty process,
-/// the largest of packing 0.005, 0.1 and the dense preset: 194, 273 and 303
+/// the largest of packing 0.005, 0.1 and the dense preset: 194, 273 and 266
 /// B; docs/benchmarks.md has the runs).
 pub fn sphere_bytes(model: ModelKind) -> u64 {
     match model {
         ModelKind::Discrete => 243,
-        ModelKind::Swept => 342,
         // `auto` may run any: the hungriest.
-        ModelKind::Exact | ModelKind::Auto(_) => 379,
+        ModelKind::Swept | ModelKind::Auto(_) => 342,
+        ModelKind::Exact => 333,
     }
 }
 
@@ -134,7 +134,7 @@ mod tests {
         assert!(check(1_000_000, Some(ModelKind::Swept), free).is_ok());
         let err = check(10_000_000, Some(ModelKind::Exact), free).unwrap_err();
         assert!(
-            err.starts_with("10000000 spheres would need about 3630 MiB"),
+            err.starts_with("10000000 spheres would need about 3191 MiB"),
             "{err}"
         );
         assert!(
@@ -161,11 +161,11 @@ mod tests {
         assert_eq!(need(usize::MAX, None), u64::MAX);
         // The screen's short form refuses the same counts.
         // The screen's short form: the app's count (hungriest model and the
-        // screen's copies, 509 bytes a sphere) against the same share.
+        // screen's copies, 472 bytes a sphere) against the same share.
         assert!(count_notice(20_000, tight).is_none());
         assert_eq!(
             count_notice(1_000_000, tight).unwrap(),
-            "count limit: 1000000 spheres need 501 MiB, over the 28 MiB a run may use"
+            "count limit: 1000000 spheres need 466 MiB, over the 28 MiB a run may use"
         );
     }
 }
