@@ -48,6 +48,29 @@ pub fn apply<T: Copy>(v: &mut [T], perm: &[Label]) {
     }
 }
 
+/// [`apply`] to the records of `width` items each that `v` holds, one a sphere.
+pub fn apply_chunks<T: Copy + Default>(v: &mut [T], width: usize, perm: &[Label]) {
+    let mut done = vec![false; perm.len()];
+    let mut first = vec![T::default(); width];
+    for start in 0..perm.len() {
+        if done[start] {
+            continue;
+        }
+        first.copy_from_slice(&v[start * width..(start + 1) * width]);
+        let mut at = start;
+        loop {
+            done[at] = true;
+            let from = perm[at].index();
+            if from == start {
+                v[at * width..(at + 1) * width].copy_from_slice(&first);
+                break;
+            }
+            v.copy_within(from * width..(from + 1) * width, at * width);
+            at = from;
+        }
+    }
+}
+
 /// A pair event names its partner by label: relabel it.
 fn relabel(ev: &mut Event, inv: &[Label]) {
     if ev.kind == Kind::Pair {
@@ -123,6 +146,10 @@ mod tests {
         let mut v: Vec<u32> = (100..107).collect();
         apply(&mut v, &perm);
         assert_eq!(v, raw.map(|o| 100 + o));
+        let mut w: Vec<u32> = (0..14).collect();
+        apply_chunks(&mut w, 2, &perm);
+        let want: Vec<u32> = raw.iter().flat_map(|&o| [2 * o, 2 * o + 1]).collect();
+        assert_eq!(w, want);
         let inv = inverse(&perm);
         for (new, &old) in perm.iter().enumerate() {
             assert_eq!(inv[old.index()], Label::at(new));

@@ -20,7 +20,7 @@ use super::body::{Bodies, Body};
 use super::ids::{Cell, Label, SpeciesId};
 use super::large::{BIG_FACTOR, split_big, time_to_leave};
 #[cfg(feature = "experiments")]
-use super::renumber::apply;
+use super::renumber::{apply, apply_chunks};
 use crate::physics::huge_pages;
 use chains::CellChains;
 use glam::DVec3;
@@ -35,13 +35,18 @@ const TARGET_NEIGHBOURS: f64 = 12.0;
 /// Relist a little before the skin is used up, so rounding in the lazy
 /// positions can never let a non-neighbour slip into contact.
 const TRIGGER: f64 = 1.0 - 1e-6;
-/// Links a list keeps in its sphere's own line: one cache line (64
-/// bytes) a sphere, read whole by every prediction. A list that grows past
-/// it moves out of line until the sphere relists. At a million dense
-/// spheres lists hold 12 to 13.5 links on average and at most 18 (the
-/// lattice start: 1.9 % past 16, 0.01 % once the fluid has melted), where
-/// a stride sized by the longest list took 24 links (docs/benchmarks.md).
+/// Links in a cache line: a list of this many or fewer, at a stride of
+/// this many, is one line.
 const LINE_LINKS: usize = 16;
+/// The stride of the lists in the flat array is a multiple of this many
+/// links, chosen by a build from its lists' lengths ([`best_stride`]).
+const STRIDE_STEP: usize = 8;
+/// What a list out of line costs, in bytes: its `Vec` (24), room for 32
+/// links (128) and the allocator's header (16). A build weighs it against
+/// a wider stride for every sphere.
+const OUT_BYTES: usize = 168;
+/// At most one list in this many out of line after a build.
+const OUT_AT_MOST: usize = 16;
 
 /// A list centre with the sphere's species beside it (its radius from the
 /// species table, a few lines every scan shares): 28 bytes, packed, where a
@@ -69,19 +74,13 @@ pub struct Link {
     pub j: Label,
 }
 
-/// A sphere's list when it fits its line: the links, the first
-/// `len` of them in use; aligned, so a list is one cache line.
-#[derive(Clone, Copy, Debug, Default)]
-#[repr(C, align(64))]
-struct Line([Link; LINE_LINKS]);
-
-/// Where a sphere's list is kept, as its word in `Lists::len` says: in its
-/// own [`Line`] with this length, or the `Out(k)`th of the lists kept out
-/// of line (one past [`LINE_LINKS`] links, or a large sphere's). One word a
-/// sphere, read by every look-up.
+/// Where a sphere's list is kept, as its word in `Lists::len` says: in the
+/// flat array at its place, with this length, or the `Out(k)`th of the
+/// lists kept out of line (one that outgrew the stride, or a large
+/// sphere's). One word a sphere, read by every look-up.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Home {
-    Line(usize),
+    Flat(usize),
     Out(usize),
 }
 
@@ -95,37 +94,99 @@ impl Home {
     #[inline(always)]
     fn of(word: u32) -> Home {
         if word & OUT == 0 {
-            Home::Line(word as usize)
+            Home::Flat(word as usize)
         } else {
             Home::Out((word & !(OUT | LARGE)) as usize)
         }
     }
 }
 
-/// Neighbour lists: each sphere's in its own cache line while it fits
-/// (nearly all), the rest (a list that outgrew its line, and the few
-/// large spheres', which may hold thousands) in growable lists of their
-/// own.
+/// The stride, a multiple of [`STRIDE_STEP`] links, that holds lists of
+/// the lengths `counts` (`counts[k]` lists of `k` links) in the fewest
+/// bytes, the lists longer than it out of line at [`OUT_BYTES`] each, and
+/// at most one list in [`OUT_AT_MOST`] out (a list out of line is slower
+/// to read). At a million dense spheres (lattice start: 13.5 links on
+/// average, 1.9 % past 16) that is 16, one cache line; on a start where
+/// most lists hold 16 to 18, 24.
+fn best_stride(counts: &[usize]) -> usize {
+    let total: usize = counts.iter().sum();
+    let longest = counts.iter().rposition(|&c| c > 0).unwrap_or(0);
+    let out = |stride: usize| counts.iter().skip(stride + 1).sum::<usize>();
+    (1..=longest.div_ceil(STRIDE_STEP).max(1))
+        .map(|k| k * STRIDE_STEP)
+        .filter(|&s| out(s) * OUT_AT_MOST <= total)
+        .min_by_key(|&s| total * s * size_of::<Link>() + out(s) * OUT_BYTES)
+        .unwrap_or(STRIDE_STEP)
+}
+
+/// Neighbour lists: the bulk's in one flat array at one stride (no
+/// pointer a list; the array starts on a cache line, so at a stride of 16
+/// a list is one line), the rest (a list that outgrew the stride, until
+/// its sphere relists, and the few large spheres', which may hold
+/// thousands) in growable lists of their own.
 #[derive(Clone, Debug, Default)]
 struct Lists {
-    lines: Vec<Line>,
-    /// Each sphere's [`Home`] as a word: its line's length, or [`OUT`]
+    stride: usize,
+    /// Where the first list starts in `flat`: its first link on a line.
+    base: usize,
+    flat: Vec<Link>,
+    /// Each sphere's [`Home`] as a word: its flat list's length, or [`OUT`]
     /// (and [`LARGE`]) and its place in `out`.
     len: Vec<u32>,
     out: Vec<Vec<Link>>,
-    /// Places in `out` whose list went back in line, for the next one out.
+    /// Places in `out` whose list went back in the flat array, for the
+    /// next one out.
     free: Vec<u32>,
 }
 
 impl Lists {
-    /// Empty lists for `n` spheres, all in line. The old lines go first, so
-    /// two arrays are never held at once.
-    fn reset(&mut self, n: usize) {
+    /// Empty lists for `n` spheres, all in the flat array at `stride`.
+    fn reset(&mut self, n: usize, stride: usize) {
         huge_pages::refill(&mut self.len, n, 0);
-        self.lines = Vec::new();
-        self.lines = huge_pages::filled(n, Line::default());
         self.out.clear();
         self.free.clear();
+        self.set_stride(stride);
+    }
+
+    /// A new flat array at `stride`, every flat list emptied. The old one
+    /// goes first, so the two are never held at once.
+    fn set_stride(&mut self, stride: usize) {
+        self.stride = stride;
+        self.flat = Vec::new();
+        // A line's worth more, to start on a line wherever the array is.
+        let links = self.len.len() * stride + LINE_LINKS;
+        self.flat = huge_pages::filled(links, Link::default());
+        self.base = self.flat.as_ptr().align_offset(64).min(LINE_LINKS);
+        for w in &mut self.len {
+            if *w & OUT == 0 {
+                *w = 0;
+            }
+        }
+    }
+
+    /// Count a pair found by a build's first pass (in the lengths).
+    #[inline]
+    fn count(&mut self, i: Label, j: Label) {
+        for k in [i, j] {
+            if !self.is_big(k) {
+                self.len[k.index()] += 1;
+            }
+        }
+    }
+
+    /// After a build's counting pass: the stride [`best_stride`] picks for
+    /// the lengths counted, every list empty again.
+    fn fit_counts(&mut self) {
+        let mut counts = Vec::new();
+        for &w in &self.len {
+            if let Home::Flat(len) = Home::of(w) {
+                if counts.len() <= len {
+                    counts.resize(len + 1, 0);
+                }
+                counts[len] += 1;
+            }
+        }
+        self.set_stride(best_stride(&counts));
     }
 
     /// Whether `i` is a large sphere (its list growable, itself in no cell).
@@ -151,10 +212,16 @@ impl Lists {
         Home::of(self.len[i.index()])
     }
 
+    /// Where `i`'s place in the flat array starts.
+    #[inline(always)]
+    fn at(&self, i: Label) -> usize {
+        self.base + i.index() * self.stride
+    }
+
     #[inline]
     fn of(&self, i: Label) -> &[Link] {
         match self.home(i) {
-            Home::Line(len) => &self.lines[i.index()].0[..len],
+            Home::Flat(len) => &self.flat[self.at(i)..][..len],
             Home::Out(k) => &self.out[k],
         }
     }
@@ -162,7 +229,10 @@ impl Lists {
     #[inline]
     fn of_mut(&mut self, i: Label) -> &mut [Link] {
         match self.home(i) {
-            Home::Line(len) => &mut self.lines[i.index()].0[..len],
+            Home::Flat(len) => {
+                let at = self.at(i);
+                &mut self.flat[at..][..len]
+            }
             Home::Out(k) => &mut self.out[k],
         }
     }
@@ -170,22 +240,24 @@ impl Lists {
     #[inline]
     fn push(&mut self, i: Label, l: Link) {
         match self.home(i) {
-            Home::Line(len) if len < LINE_LINKS => {
-                self.lines[i.index()].0[len] = l;
+            Home::Flat(len) if len < self.stride => {
+                let at = self.at(i);
+                self.flat[at + len] = l;
                 self.len[i.index()] += 1;
             }
-            Home::Line(_) => self.move_out(i, l),
+            Home::Flat(_) => self.move_out(i, l),
             Home::Out(k) => self.out[k].push(l),
         }
     }
 
-    /// `i`'s full line, then `l`, in a list out of line, in order.
+    /// `i`'s full flat list, then `l`, in a list out of line, in order.
     #[cold]
     fn move_out(&mut self, i: Label, l: Link) {
         let k = self.take_out();
+        let (at, stride) = (self.at(i), self.stride);
         let list = &mut self.out[k as usize];
-        list.reserve_exact(2 * LINE_LINKS);
-        list.extend_from_slice(&self.lines[i.index()].0);
+        list.reserve_exact(2 * stride.max(LINE_LINKS));
+        list.extend_from_slice(&self.flat[at..at + stride]);
         list.push(l);
         self.len[i.index()] = OUT | k;
     }
@@ -193,7 +265,7 @@ impl Lists {
     #[inline]
     fn pop(&mut self, i: Label) {
         match self.home(i) {
-            Home::Line(_) => self.len[i.index()] -= 1,
+            Home::Flat(_) => self.len[i.index()] -= 1,
             Home::Out(k) => {
                 self.out[k].pop();
             }
@@ -224,7 +296,7 @@ impl Lists {
             }
         }
         match self.home(i) {
-            Home::Line(_) => self.len[i.index()] = 0,
+            Home::Flat(_) => self.len[i.index()] = 0,
             Home::Out(k) if self.is_big(i) => self.out[k].clear(),
             Home::Out(k) => {
                 self.out[k] = Vec::new();
@@ -238,11 +310,17 @@ impl Lists {
     /// every list keeps its order.
     #[cfg(feature = "experiments")]
     fn relabel(&mut self, perm: &[Label], inv: &[Label]) {
-        apply(&mut self.lines, perm);
+        let (base, n) = (self.base, self.len.len());
+        apply_chunks(
+            &mut self.flat[base..base + n * self.stride],
+            self.stride,
+            perm,
+        );
         apply(&mut self.len, perm);
-        for (line, &w) in self.lines.iter_mut().zip(&self.len) {
-            if let Home::Line(len) = Home::of(w) {
-                for l in &mut line.0[..len] {
+        for i in 0..n {
+            if let Home::Flat(len) = self.home(Label::at(i)) {
+                let at = self.at(Label::at(i));
+                for l in &mut self.flat[at..at + len] {
                     l.j = inv[l.j.index()];
                 }
             }
@@ -272,7 +350,7 @@ impl NeighbourLists {
         let l = &self.lists;
         let out: usize = l.out.iter().map(|b| b.capacity() * size_of::<Link>()).sum();
         self.centre.capacity() * size_of::<Centre>()
-            + l.lines.capacity() * size_of::<Line>()
+            + l.flat.capacity() * size_of::<Link>()
             + l.len.capacity() * 4
             + self.bigs.capacity() * size_of::<Label>()
             + l.out.capacity() * size_of::<Vec<Link>>()
@@ -290,7 +368,7 @@ impl NeighbourLists {
             pos: b.pos.to_array(),
             species: b.species,
         }));
-        self.lists.reset(n);
+        self.lists.reset(n, 0);
         self.bigs.clear();
         self.cells.reset(n, 0);
         if n == 0 {
@@ -324,8 +402,13 @@ impl NeighbourLists {
                 self.cells.insert(i, self.cell_of(b.pos));
             }
         }
+        // Count, size the flat array once, then link.
         for i in bodies.labels() {
-            self.scan(i, bodies, |j| j > i);
+            self.scan(i, bodies, |j| j > i, Lists::count);
+        }
+        self.lists.fit_counts();
+        for i in bodies.labels() {
+            self.scan(i, bodies, |j| j > i, Lists::link);
         }
     }
 
@@ -338,7 +421,7 @@ impl NeighbourLists {
             self.cells.move_to(i, from, self.cell_of(bodies[i].pos));
         }
         self.centre[i.index()].pos = bodies[i].pos.to_array();
-        self.scan(i, bodies, |j| j != i);
+        self.scan(i, bodies, |j| j != i, Lists::link);
     }
 
     /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
@@ -359,18 +442,21 @@ impl NeighbourLists {
     }
 
     /// Start loading what predicting sphere `k` reads first: its list's
-    /// word and line, and its list's centre.
+    /// word and links, and its list's centre.
     #[inline(always)]
     pub fn prefetch(&self, k: usize) {
         use crate::physics::prefetch::{line, record};
-        if let (Some(w), Some(c), Some(l)) = (
-            self.lists.len.get(k),
-            self.centre.get(k),
-            self.lists.lines.get(k),
-        ) {
+        let l = &self.lists;
+        let at = l.base + k * l.stride;
+        if let (Some(w), Some(c), Some(first)) = (l.len.get(k), self.centre.get(k), l.flat.get(at))
+        {
             line(w);
             record(c);
-            line(l);
+            line(first);
+            // A stride past a line: its last link may be on the next.
+            if let Some(last) = l.flat.get(at + l.stride - 1) {
+                line(last);
+            }
         }
     }
 
@@ -384,9 +470,16 @@ impl NeighbourLists {
         )
     }
 
-    /// Find the neighbours `j` of `i` (with `want(j)`) and link each pair.
+    /// Find the neighbours `j` of `i` (with `want(j)`) and `found(i, j)`
+    /// each pair: link it, or count it.
     #[allow(clippy::excessive_nesting)] // a box of cells, z, y, x, each cell's spheres in a closure
-    fn scan(&mut self, i: Label, bodies: &Bodies, want: impl Fn(Label) -> bool) {
+    fn scan(
+        &mut self,
+        i: Label,
+        bodies: &Bodies,
+        want: impl Fn(Label) -> bool,
+        found: impl Fn(&mut Lists, Label, Label),
+    ) {
         let ci = self.centre[i.index()].pos();
         let ri = bodies.radius(i) + 2.0 * self.skin;
         let test = |j: Label, centre: &[Centre], lists: &mut Lists| {
@@ -396,7 +489,7 @@ impl NeighbourLists {
             let c = centre[j.index()];
             let s = ri + bodies.radius_of_species(c.species);
             if (ci - c.pos()).length_squared() < s * s {
-                lists.link(i, j);
+                found(lists, i, j);
             }
         };
         let big = self.lists.is_big(i);
@@ -444,13 +537,12 @@ impl NeighbourLists {
 
 #[cfg(test)]
 mod tests {
-    use super::{Home, LINE_LINKS, Label, Line, Link, Lists};
+    use super::{Home, LINE_LINKS, Label, Link, Lists, STRIDE_STEP, best_stride};
 
     #[test]
-    fn a_link_is_the_neighbour_alone_and_a_line_one_cache_line() {
+    fn a_link_is_the_neighbour_alone() {
         // Most of the memory of `exact` at a million dense spheres.
         assert_eq!(size_of::<Link>(), 4);
-        assert_eq!((size_of::<Line>(), align_of::<Line>()), (64, 64));
     }
 
     #[test]
@@ -465,7 +557,7 @@ mod tests {
     #[test]
     fn unlinking_fills_each_hole_with_the_lists_last_entry() {
         let mut l = Lists::default();
-        l.reset(5);
+        l.reset(5, STRIDE_STEP);
         let at = Label::at;
         for (i, j) in [(0, 1), (2, 1), (1, 3), (4, 1), (0, 3)] {
             l.link(at(i), at(j));
@@ -482,19 +574,20 @@ mod tests {
         }
     }
 
-    /// A list past its line moves out of line in order, keeps working there
-    /// (holes filled by the last entry, as in line), and goes back in line
-    /// when its sphere relists; its place out of line is taken by the next.
-    /// A large sphere's list stays out of line and the sphere large.
+    /// A list past the stride moves out of line in order, keeps working
+    /// there (holes filled by the last entry, as in the flat array), and
+    /// goes back when its sphere relists; its place out of line is taken
+    /// by the next. A large sphere's list stays out of line and the sphere
+    /// large.
     #[test]
-    fn a_list_past_its_line_moves_out_and_back_in_order() {
+    fn a_list_past_the_stride_moves_out_and_back_in_order() {
         let n = 40;
         let mut l = Lists::default();
-        l.reset(n);
+        l.reset(n, STRIDE_STEP);
         let at = Label::at;
         l.make_big(at(39));
         l.link(at(39), at(1));
-        let extra = LINE_LINKS + 4;
+        let extra = STRIDE_STEP + 4;
         for j in 1..=extra {
             l.link(at(0), at(j));
         }
@@ -508,21 +601,82 @@ mod tests {
         want.pop();
         assert_eq!(ids(&l, 0), want);
         l.unlink_all(at(0));
-        assert_eq!(l.home(at(0)), Home::Line(0));
+        assert_eq!(l.home(at(0)), Home::Flat(0));
         assert_eq!(l.free.len(), 1);
         for j in 1..=extra {
             assert!(!ids(&l, j).contains(&0), "0 still in {j}'s list");
         }
-        // Sphere 2 outgrows its line: it takes the freed place.
-        for j in 3..=3 + LINE_LINKS {
+        // Sphere 2 outgrows the stride: it takes the freed place.
+        for j in 3..=3 + STRIDE_STEP {
             l.link(at(2), at(j));
         }
         assert!(matches!(l.home(at(2)), Home::Out(_)) && l.free.is_empty());
-        assert_eq!(ids(&l, 2), (3..=3 + LINE_LINKS).collect::<Vec<_>>());
+        assert_eq!(ids(&l, 2), (3..=3 + STRIDE_STEP).collect::<Vec<_>>());
         assert!(l.is_big(at(39)) && matches!(l.home(at(39)), Home::Out(_)));
         assert_eq!(ids(&l, 39), [1]);
         l.unlink_all(at(39));
         assert!(l.is_big(at(39)) && ids(&l, 39).is_empty());
         assert_eq!(ids(&l, 1), Vec::<usize>::new());
+    }
+
+    /// At a stride of a line, every list starts on one.
+    #[test]
+    fn at_a_stride_of_16_each_list_is_one_line() {
+        let mut l = Lists::default();
+        l.reset(50, LINE_LINKS);
+        for i in 0..50 {
+            let first = l.flat[l.at(Label::at(i))..].as_ptr();
+            assert_eq!(first.addr() % 64, 0, "list {i}");
+        }
+    }
+
+    /// The stride holds the lengths in the fewest bytes, counting a list
+    /// out of line at its cost: one line for a million dense spheres'
+    /// lattice start (lengths counted at 1M), a stride past the bulk when
+    /// most lists are 16 to 18 long (a lattice at 100k).
+    #[test]
+    fn the_stride_follows_the_lengths_counted() {
+        let million = [
+            0, 0, 0, 0, 16, 100, 413, 1671, 5550, 12208, 23025, 53987, 133_080, 236_024, 263_266,
+            179_056, 72362, 17338, 1904,
+        ];
+        assert_eq!(best_stride(&million), 16);
+        let lattice = [
+            0, 0, 0, 0, 0, 4, 4, 37, 185, 325, 266, 1706, 4906, 4838, 816, 5867, 21134, 34845,
+            25067,
+        ];
+        assert_eq!(best_stride(&lattice), 24);
+        assert_eq!(best_stride(&[]), STRIDE_STEP);
+        assert_eq!(best_stride(&[5, 0, 0, 7]), STRIDE_STEP);
+        // A few long lists go out of line rather than widen every one, but
+        // not a tenth of them, even where that would take fewer bytes.
+        let mut few = vec![0; 41];
+        (few[12], few[40]) = (1000, 3);
+        assert_eq!(best_stride(&few), 16);
+        (few[12], few[20]) = (900, 100);
+        assert_eq!(best_stride(&few), 24);
+    }
+
+    /// A build counts, then sizes the stride, every list empty again; the
+    /// large sphere's many neighbours do not count.
+    #[test]
+    fn counting_sizes_the_stride_and_empties_the_lists() {
+        let mut l = Lists::default();
+        let n = 30;
+        l.reset(n, 0);
+        let at = Label::at;
+        l.make_big(at(25));
+        for j in 1..=20 {
+            l.count(at(0), at(j));
+            l.count(at(25), at(j));
+        }
+        l.fit_counts();
+        // One list of 20 and twenty of 1 or 2: 8 and one list out.
+        assert_eq!(l.stride, STRIDE_STEP);
+        assert_eq!(ids(&l, 0), Vec::<usize>::new());
+        assert!(l.is_big(at(25)));
+        l.link(at(25), at(4));
+        assert_eq!(ids(&l, 25), [4]);
+        assert_eq!(ids(&l, 4), [25]);
     }
 }
