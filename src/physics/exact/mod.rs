@@ -652,10 +652,11 @@ impl<Q: EventQueue + Send> Model for EventDriven<Q> {
 }
 
 /// Cell mode: if sphere `next`'s queued event is a crossing, start loading
-/// the cells it will read. Called part-way through an event: `next`'s slot
-/// was asked for as the event began, and has had the event's first misses
-/// to arrive, so the crossing's cells load while the rest of the event
-/// runs, a whole event before they are read.
+/// the cells it will read. Called part-way through a crossing (after its
+/// gather and move): `next`'s slot was asked for as the crossing began and
+/// has arrived by then, so the next crossing's cells load while the rest
+/// of this one runs, a whole event before they are read. (In a contact or
+/// a wall event the slot has not arrived in time: docs/perf-log.md.)
 #[inline(always)]
 fn prefetch_next_crossing(cells: &CellGrid, slots: &[Slot], next: usize) {
     if let Some(s) = slots.get(next) {
