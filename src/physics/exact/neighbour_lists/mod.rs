@@ -454,7 +454,7 @@ impl NeighbourLists {
             record(c);
             line(first);
             // A stride past a line: its last link may be on the next.
-            if let Some(last) = l.flat.get(at + l.stride - 1) {
+            if let Some(last) = l.flat.get(at + l.stride.saturating_sub(1)) {
                 line(last);
             }
         }
