@@ -41,9 +41,9 @@ const LINE_LINKS: usize = 16;
 /// The stride of the lists in the flat array is a multiple of this many
 /// links, chosen by a build from its lists' lengths ([`best_stride`]).
 const STRIDE_STEP: usize = 8;
-/// What a list out of line costs, in bytes: its `Vec` (24), room for 32
-/// links (128) and the allocator's header (16). A build weighs it against
-/// a wider stride for every sphere.
+/// What a list out of line costs, in bytes, at a stride of 16: its `Vec`
+/// (24), room for twice the stride (128) and the allocator's header (16).
+/// A build weighs it against a wider stride for every sphere.
 const OUT_BYTES: usize = 168;
 /// At most one list in this many out of line after a build.
 const OUT_AT_MOST: usize = 16;
@@ -317,10 +317,10 @@ impl Lists {
             perm,
         );
         apply(&mut self.len, perm);
-        for i in 0..n {
-            if let Home::Flat(len) = self.home(Label::at(i)) {
-                let at = self.at(Label::at(i));
-                for l in &mut self.flat[at..at + len] {
+        // Flat lists here, the ones out of line below (each once).
+        for i in (0..n).map(Label::at) {
+            if let Home::Flat(_) = self.home(i) {
+                for l in self.of_mut(i) {
                     l.j = inv[l.j.index()];
                 }
             }
