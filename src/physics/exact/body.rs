@@ -78,6 +78,11 @@ impl Bodies {
         self.species.get(s).radius
     }
 
+    /// How many species the table names (every one has a body).
+    pub fn species_count(&self) -> usize {
+        self.species.len()
+    }
+
     #[inline(always)]
     pub fn radius(&self, i: Label) -> f64 {
         self.radius_of(&self[i])

@@ -53,7 +53,6 @@ impl SpeciesTable {
         self.list[k.index()]
     }
 
-    #[cfg(test)]
     pub fn len(&self) -> usize {
         self.list.len()
     }

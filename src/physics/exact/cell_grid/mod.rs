@@ -15,7 +15,7 @@ mod blocks;
 
 use super::body::{Bodies, Body};
 use super::ids::Label;
-use super::large::{BIG_FACTOR, split_big, time_to_leave};
+use super::large::{BIG_FACTOR, Split, split_big, time_to_leave};
 #[cfg(feature = "experiments")]
 use super::renumber::apply;
 use super::schedule::{Event, Kind};
@@ -96,8 +96,12 @@ impl CellGrid {
             self.per_side = 1;
             return;
         }
-        let big_above;
-        (big_above, self.small_rmax) = split_big(bodies, BIG_FACTOR);
+        let Split {
+            big_above,
+            small_rmax,
+            ..
+        } = split_big(bodies, BIG_FACTOR);
+        self.small_rmax = small_rmax;
         // A little over a diameter, so rounding at a crossing can never
         // leave touching spheres two cells apart.
         let cell_min = 2.0 * self.small_rmax * (1.0 + 1e-9);

@@ -18,7 +18,7 @@ mod chains;
 
 use super::body::{Bodies, Body};
 use super::ids::{Cell, Label, SpeciesId};
-use super::large::{BIG_FACTOR, split_big, time_to_leave};
+use super::large::{BIG_FACTOR, Split, split_big, time_to_leave};
 #[cfg(feature = "experiments")]
 use super::renumber::{apply, apply_chunks};
 use crate::physics::huge_pages;
@@ -48,14 +48,13 @@ const OUT_BYTES: usize = 168;
 /// At most one list in this many out of line after a build.
 const OUT_AT_MOST: usize = 16;
 
-/// A list centre with the sphere's species beside it (its radius from the
-/// species table, a few lines every scan shares): 28 bytes, packed, where a
-/// radius beside an aligned centre took 32.
+/// A list centre: 24 bytes. The sphere's radius, which a scan reads beside
+/// it, is the one radius of the scene or, with several species, from
+/// [`NeighbourLists::species`].
 #[derive(Clone, Copy, Debug, Default)]
-#[repr(C, packed(4))]
+#[repr(C)]
 struct Centre {
     pos: [f64; 3],
-    species: SpeciesId,
 }
 
 impl Centre {
@@ -335,6 +334,9 @@ impl Lists {
 pub struct NeighbourLists {
     skin: f64,
     centre: Vec<Centre>,
+    /// Each sphere's species, beside its centre for the scans; empty when
+    /// the scene has one (every preset), which saves 4 bytes a sphere.
+    species: Vec<SpeciesId>,
     lists: Lists,
     per_side: usize,
     inv_cell: f64,
@@ -350,6 +352,7 @@ impl NeighbourLists {
         let l = &self.lists;
         let out: usize = l.out.iter().map(|b| b.capacity() * size_of::<Link>()).sum();
         self.centre.capacity() * size_of::<Centre>()
+            + self.species.capacity() * size_of::<SpeciesId>()
             + l.flat.capacity() * size_of::<Link>()
             + l.len.capacity() * 4
             + self.bigs.capacity() * size_of::<Label>()
@@ -366,19 +369,24 @@ impl NeighbourLists {
         huge_pages::reserve(&mut self.centre, n);
         self.centre.extend(bodies.iter().map(|b| Centre {
             pos: b.pos.to_array(),
-            species: b.species,
         }));
+        self.species.clear();
+        if bodies.species_count() > 1 {
+            huge_pages::reserve(&mut self.species, n);
+            self.species.extend(bodies.iter().map(|b| b.species));
+        }
         self.lists.reset(n, 0);
         self.bigs.clear();
         self.cells.reset(n, 0);
         if n == 0 {
             return;
         }
-        let mut radii: Vec<f64> = bodies.iter().map(|b| bodies.radius_of(b)).collect();
-        let k = (n * 98 / 100).min(n - 1);
-        let bulk = *radii.select_nth_unstable_by(k, f64::total_cmp).1;
-        let big_above;
-        (big_above, self.small_rmax) = split_big(bodies, BIG_FACTOR);
+        let Split {
+            bulk,
+            big_above,
+            small_rmax,
+        } = split_big(bodies, BIG_FACTOR);
+        self.small_rmax = small_rmax;
         // Ideal-gas estimate of the distance that holds TARGET_NEIGHBOURS.
         let density = n as f64 / (size * size * size);
         let reach = (TARGET_NEIGHBOURS / (density * 4.0 / 3.0 * std::f64::consts::PI)).cbrt();
@@ -429,6 +437,9 @@ impl NeighbourLists {
     #[cfg(feature = "experiments")]
     pub fn relabel(&mut self, perm: &[Label], inv: &[Label]) {
         apply(&mut self.centre, perm);
+        if !self.species.is_empty() {
+            apply(&mut self.species, perm);
+        }
         self.lists.relabel(perm, inv);
         self.cells.relabel(perm, inv);
         for b in &mut self.bigs {
@@ -482,13 +493,15 @@ impl NeighbourLists {
     ) {
         let ci = self.centre[i.index()].pos();
         let ri = bodies.radius(i) + 2.0 * self.skin;
-        let test = |j: Label, centre: &[Centre], lists: &mut Lists| {
+        // One species: every sphere's radius is i's.
+        let one_radius = self.species.is_empty().then(|| bodies.radius(i));
+        let test = |j: Label, centre: &[Centre], species: &[SpeciesId], lists: &mut Lists| {
             if !want(j) {
                 return;
             }
-            let c = centre[j.index()];
-            let s = ri + bodies.radius_of_species(c.species);
-            if (ci - c.pos()).length_squared() < s * s {
+            let rj = one_radius.unwrap_or_else(|| bodies.radius_of_species(species[j.index()]));
+            let s = ri + rj;
+            if (ci - centre[j.index()].pos()).length_squared() < s * s {
                 found(lists, i, j);
             }
         };
@@ -513,13 +526,13 @@ impl NeighbourLists {
             for y in lo[1]..=hi[1] {
                 for x in lo[0]..=hi[0] {
                     self.cells.for_each_in(x + p * (y + p * z), |j| {
-                        test(j, &self.centre, &mut self.lists);
+                        test(j, &self.centre, &self.species, &mut self.lists);
                     });
                 }
             }
         }
         for k in 0..self.bigs.len() {
-            test(self.bigs[k], &self.centre, &mut self.lists);
+            test(self.bigs[k], &self.centre, &self.species, &mut self.lists);
         }
     }
 
@@ -546,8 +559,8 @@ mod tests {
     }
 
     #[test]
-    fn a_centre_is_28_bytes() {
-        assert_eq!(size_of::<super::Centre>(), 28);
+    fn a_centre_is_24_bytes() {
+        assert_eq!(size_of::<super::Centre>(), 24);
     }
 
     fn ids(l: &Lists, i: usize) -> Vec<usize> {
