@@ -73,32 +73,27 @@ pub struct Link {
     pub j: Label,
 }
 
-/// Where a sphere's list is kept, as its word in `Lists::len` says: in the
-/// flat array at its place, with this length, or the `Out(k)`th of the
+/// Where a sphere's list is kept, as its byte in `Lists::len` says: in
+/// the flat array at its place, with this length, or the `Out(k)`th of the
 /// lists kept out of line (one that outgrew the stride, or a large
-/// sphere's). One word a sphere, read by every look-up.
+/// sphere's), `k` kept in the first link of its place (unused while the
+/// list is out). One byte a sphere, read by every look-up: at a million,
+/// 1 MB where a word took 4.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Home {
     Flat(usize),
     Out(usize),
 }
 
-/// The top bit of a `Lists::len` word: the list is out of line.
-const OUT: u32 = 1 << 31;
-/// The next bit: the sphere is large (its list always out of line, itself
-/// in no cell).
-const LARGE: u32 = 1 << 30;
-
-impl Home {
-    #[inline(always)]
-    fn of(word: u32) -> Home {
-        if word & OUT == 0 {
-            Home::Flat(word as usize)
-        } else {
-            Home::Out((word & !(OUT | LARGE)) as usize)
-        }
-    }
-}
+/// A `Lists::len` byte: the list is out of line.
+const OUT: u8 = u8::MAX;
+/// A `Lists::len` byte: the sphere is large (its list always out of line,
+/// itself in no cell).
+const LARGE: u8 = u8::MAX - 1;
+/// The longest list a `Lists::len` byte holds in the flat array.
+const MAX_FLAT: u8 = LARGE - 1;
+/// The widest stride: lists of up to [`MAX_FLAT`] links, in whole steps.
+const MAX_STRIDE: usize = MAX_FLAT as usize / STRIDE_STEP * STRIDE_STEP;
 
 /// The stride, a multiple of [`STRIDE_STEP`] links, that holds lists of
 /// the lengths `counts` (`counts[k]` lists of `k` links) in the fewest
@@ -111,11 +106,13 @@ fn best_stride(counts: &[usize]) -> usize {
     let total: usize = counts.iter().sum();
     let longest = counts.iter().rposition(|&c| c > 0).unwrap_or(0);
     let out = |stride: usize| counts.iter().skip(stride + 1).sum::<usize>();
-    (1..=longest.div_ceil(STRIDE_STEP).max(1))
+    (1..=longest
+        .div_ceil(STRIDE_STEP)
+        .clamp(1, MAX_STRIDE / STRIDE_STEP))
         .map(|k| k * STRIDE_STEP)
         .filter(|&s| out(s) * OUT_AT_MOST <= total)
         .min_by_key(|&s| total * s * size_of::<Link>() + out(s) * OUT_BYTES)
-        .unwrap_or(STRIDE_STEP)
+        .unwrap_or(MAX_STRIDE)
 }
 
 /// Neighbour lists: the bulk's in one flat array at one stride (no
@@ -129,9 +126,9 @@ struct Lists {
     /// Where the first list starts in `flat`: its first link on a line.
     base: usize,
     flat: Vec<Link>,
-    /// Each sphere's [`Home`] as a word: its flat list's length, or [`OUT`]
-    /// (and [`LARGE`]) and its place in `out`.
-    len: Vec<u32>,
+    /// Each sphere's [`Home`] as a byte: its flat list's length, [`OUT`]
+    /// or [`LARGE`].
+    len: Vec<u8>,
     out: Vec<Vec<Link>>,
     /// Places in `out` whose list went back in the flat array, for the
     /// next one out.
@@ -142,23 +139,25 @@ impl Lists {
     /// Empty lists for `n` spheres, all in the flat array at `stride`.
     fn reset(&mut self, n: usize, stride: usize) {
         huge_pages::refill(&mut self.len, n, 0);
-        self.out.clear();
-        self.free.clear();
         self.set_stride(stride);
     }
 
-    /// A new flat array at `stride`, every flat list emptied. The old one
-    /// goes first, so the two are never held at once.
+    /// A new flat array at `stride`, every flat list emptied and the
+    /// large spheres' lists (out of line) emptied. The old array goes
+    /// first, so the two are never held at once.
     fn set_stride(&mut self, stride: usize) {
         self.stride = stride;
         self.flat = Vec::new();
+        self.out.clear();
+        self.free.clear();
         // A line's worth more, to start on a line wherever the array is.
         let links = self.len.len() * stride + LINE_LINKS;
         self.flat = huge_pages::filled(links, Link::default());
         self.base = self.flat.as_ptr().align_offset(64).min(LINE_LINKS);
-        for w in &mut self.len {
-            if *w & OUT == 0 {
-                *w = 0;
+        for i in (0..self.len.len()).map(Label::at) {
+            match self.len[i.index()] {
+                LARGE => self.make_big(i),
+                _ => self.len[i.index()] = 0,
             }
         }
     }
@@ -167,8 +166,9 @@ impl Lists {
     #[inline]
     fn count(&mut self, i: Label, j: Label) {
         for k in [i, j] {
-            if !self.is_big(k) {
-                self.len[k.index()] += 1;
+            let w = &mut self.len[k.index()];
+            if *w < MAX_FLAT {
+                *w += 1;
             }
         }
     }
@@ -178,7 +178,8 @@ impl Lists {
     fn fit_counts(&mut self) {
         let mut counts = Vec::new();
         for &w in &self.len {
-            if let Home::Flat(len) = Home::of(w) {
+            if w <= MAX_FLAT {
+                let len = usize::from(w);
                 if counts.len() <= len {
                     counts.resize(len + 1, 0);
                 }
@@ -191,11 +192,23 @@ impl Lists {
     /// Whether `i` is a large sphere (its list growable, itself in no cell).
     #[inline]
     fn is_big(&self, i: Label) -> bool {
-        self.len[i.index()] & LARGE != 0
+        self.len[i.index()] == LARGE
     }
 
+    /// `i` is large: its list is out of line for good (once there is a
+    /// stride, so a place to say where).
     fn make_big(&mut self, i: Label) {
-        self.len[i.index()] = OUT | LARGE | self.take_out();
+        self.len[i.index()] = LARGE;
+        if self.stride > 0 {
+            let k = self.take_out();
+            self.set_out_place(i, k);
+        }
+    }
+
+    /// Where `i`'s list out of line is: in its unused place's first link.
+    fn set_out_place(&mut self, i: Label, k: u32) {
+        let at = self.at(i);
+        self.flat[at].j = Label::from_raw(k);
     }
 
     /// A free place in `out`, its list empty.
@@ -208,7 +221,18 @@ impl Lists {
 
     #[inline(always)]
     fn home(&self, i: Label) -> Home {
-        Home::of(self.len[i.index()])
+        match self.len[i.index()] {
+            w if w <= MAX_FLAT => Home::Flat(usize::from(w)),
+            _ => self.out_home(i),
+        }
+    }
+
+    /// The home of a list out of line: few are, so this stays off the
+    /// look-up's path.
+    #[cold]
+    #[inline(never)]
+    fn out_home(&self, i: Label) -> Home {
+        Home::Out(self.flat[self.at(i)].j.index())
     }
 
     /// Where `i`'s place in the flat array starts.
@@ -258,7 +282,8 @@ impl Lists {
         list.reserve_exact(2 * stride.max(LINE_LINKS));
         list.extend_from_slice(&self.flat[at..at + stride]);
         list.push(l);
-        self.len[i.index()] = OUT | k;
+        self.len[i.index()] = OUT;
+        self.set_out_place(i, k);
     }
 
     #[inline]
@@ -354,7 +379,7 @@ impl NeighbourLists {
         self.centre.capacity() * size_of::<Centre>()
             + self.species.capacity() * size_of::<SpeciesId>()
             + l.flat.capacity() * size_of::<Link>()
-            + l.len.capacity() * 4
+            + l.len.capacity()
             + self.bigs.capacity() * size_of::<Label>()
             + l.out.capacity() * size_of::<Vec<Link>>()
             + out
@@ -630,6 +655,31 @@ mod tests {
         l.unlink_all(at(39));
         assert!(l.is_big(at(39)) && ids(&l, 39).is_empty());
         assert_eq!(ids(&l, 1), Vec::<usize>::new());
+    }
+
+    /// A sphere's byte counts up to the longest list the flat array may
+    /// hold, and no stride is wider: longer lists go out of line, even
+    /// when most lists are that long.
+    #[test]
+    fn a_length_byte_bounds_the_stride() {
+        let mut l = Lists::default();
+        l.reset(400, 0);
+        for j in 1..400 {
+            l.count(Label::at(0), Label::at(j));
+        }
+        assert_eq!(l.len[0], super::MAX_FLAT);
+        assert_eq!(l.len[1], 1);
+        let mut long = vec![0; usize::from(super::MAX_FLAT) + 1];
+        long[usize::from(super::MAX_FLAT)] = 1000;
+        assert_eq!(best_stride(&long), super::MAX_STRIDE);
+        assert!(super::MAX_STRIDE <= usize::from(super::MAX_FLAT));
+        l.fit_counts();
+        assert_eq!(l.stride, STRIDE_STEP, "one long list goes out");
+        for j in 1..=super::MAX_STRIDE + 1 {
+            l.link(Label::at(0), Label::at(j));
+        }
+        assert!(matches!(l.home(Label::at(0)), Home::Out(_)));
+        assert_eq!(ids(&l, 0).len(), super::MAX_STRIDE + 1);
     }
 
     /// At a stride of a line, every list starts on one.
