@@ -241,6 +241,12 @@ impl<Q: EventQueue> EventDriven<Q> {
     }
 
     fn load(&mut self, world: &World) {
+        // An event names its partner in 26 bits; a scene holds at most 10^7.
+        assert!(
+            world.spheres.len() <= schedule::MAX_SPHERES,
+            "exact takes at most {} spheres",
+            schedule::MAX_SPHERES
+        );
         self.size = world.size;
         self.origin = world.time;
         self.synced_time = world.time;
@@ -309,10 +315,7 @@ impl<Q: EventQueue> EventDriven<Q> {
         let a = &self.bodies[i];
         match &self.broad {
             Broad::Lists(nl) => {
-                let relist = Event {
-                    kind: Kind::Relist,
-                    ..Event::default()
-                };
+                let relist = Event::of(Kind::Relist, 0);
                 let t = nl.relist_time(i, a);
                 // No prefetch here: the loop asked for these bodies as the
                 // event began (a relist has just read them).
@@ -338,7 +341,11 @@ impl<Q: EventQueue> EventDriven<Q> {
                 }
                 let (t, ev) = p.finish();
                 let slot = &mut self.slots[i.index()];
-                *slot = Slot { t, ev };
+                *slot = Slot {
+                    t,
+                    ev,
+                    queued: Queued::PENDING,
+                };
                 with_crossing(cells, slot, i, a)
             }
         }
@@ -368,7 +375,7 @@ impl<Q: EventQueue> EventDriven<Q> {
             prefetch_next_crossing(cells, &self.slots, next);
         }
         let (tp, evp) = self.slots[i.index()].pending();
-        if evp.kind == Kind::Pair && self.bodies[evp.partner].count != evp.partner_count {
+        if evp.kind() == Kind::Pair && self.bodies[evp.partner()].count != evp.partner_count() {
             self.schedule::<PF>(i);
             return;
         }
@@ -379,7 +386,11 @@ impl<Q: EventQueue> EventDriven<Q> {
         }
         let (t, ev) = p.finish();
         let slot = &mut self.slots[i.index()];
-        *slot = Slot { t, ev };
+        *slot = Slot {
+            t,
+            ev,
+            queued: Queued::PENDING,
+        };
         let t = with_crossing(cells, slot, i, a);
         self.queue.update(i.index(), t);
     }
@@ -436,10 +447,10 @@ impl<Q: EventQueue> EventDriven<Q> {
                 usize::MAX
             };
             self.bodies[i].advance(t);
-            match ev.kind {
+            match ev.kind() {
                 Kind::Pair => {
-                    let j = ev.partner;
-                    if self.bodies[j].count != ev.partner_count {
+                    let j = ev.partner();
+                    if self.bodies[j].count != ev.partner_count() {
                         self.stats.stale += 1;
                         self.schedule::<PF>(i);
                         continue;
@@ -458,7 +469,7 @@ impl<Q: EventQueue> EventDriven<Q> {
                 Kind::Wall => {
                     self.stats.walls += 1;
                     let mut s = self.bodies.sphere(i);
-                    let mask = [ev.mask & 1 != 0, ev.mask & 2 != 0, ev.mask & 4 != 0];
+                    let mask = [ev.mask() & 1 != 0, ev.mask() & 2 != 0, ev.mask() & 4 != 0];
                     onto_walls(&mut s, mask, self.size);
                     let (imp, hits) = reflect_walls(&mut s, mask);
                     let b = &mut self.bodies[i];
@@ -479,7 +490,7 @@ impl<Q: EventQueue> EventDriven<Q> {
                 }
                 Kind::Cross => {
                     self.stats.crossings += 1;
-                    self.cross::<PF>(i, ev.mask, next);
+                    self.cross::<PF>(i, ev.mask(), next);
                 }
                 // An idle sphere's time is infinite: it is never popped
                 // before the end of a step, and nothing happens to it.
@@ -498,17 +509,17 @@ impl<Q: EventQueue> EventDriven<Q> {
     /// ([`prefetch_next_crossing`]).
     #[inline(always)]
     fn prefetch_ahead(&self, i: Label, ev: Event) -> usize {
-        match (ev.kind, &self.broad) {
+        match (ev.kind(), &self.broad) {
             (Kind::Cross, Broad::Cells(cells)) => {
-                cells.prefetch_cross(i, ev.mask);
+                cells.prefetch_cross(i, ev.mask());
                 // The crossing checks whether its pending contact still holds.
                 let (_, pending) = self.slots[i.index()].pending();
-                if pending.kind == Kind::Pair {
-                    self.bodies.prefetch_one(pending.partner);
+                if pending.kind() == Kind::Pair {
+                    self.bodies.prefetch_one(pending.partner());
                 }
             }
             (Kind::Pair, _) => {
-                self.prefetch_records(ev.partner.index());
+                self.prefetch_records(ev.partner().index());
                 self.prefetch_neighbours(i);
             }
             (Kind::Wall, _) => self.prefetch_neighbours(i),
@@ -660,9 +671,9 @@ impl<Q: EventQueue + Send> Model for EventDriven<Q> {
 #[inline(always)]
 fn prefetch_next_crossing(cells: &CellGrid, slots: &[Slot], next: usize) {
     if let Some(s) = slots.get(next) {
-        let ev = s.ev.queued;
-        if ev.is_broad() && ev.event().kind == Kind::Cross {
-            cells.prefetch_cross(Label::at(next), ev.event().mask);
+        let q = s.queued;
+        if q.is_broad() && q.event().kind() == Kind::Cross {
+            cells.prefetch_cross(Label::at(next), q.event().mask());
         }
     }
 }
@@ -678,7 +689,7 @@ fn with_crossing(cells: &CellGrid, slot: &mut Slot, i: Label, a: &body::Body) ->
     // By index: which comes first is random, and a branch on it
     // mispredicted a third of the time.
     let first = usize::from(tc <= tp);
-    slot.ev.queued = [Queued::PENDING, Queued::broad(&ev)][first];
+    slot.queued = [Queued::PENDING, Queued::broad(&ev)][first];
     [tp, tc][first]
 }
 

@@ -73,8 +73,8 @@ pub fn apply_chunks<T: Copy + Default>(v: &mut [T], width: usize, perm: &[Label]
 
 /// A pair event names its partner by label: relabel it.
 fn relabel(ev: &mut Event, inv: &[Label]) {
-    if ev.kind == Kind::Pair {
-        ev.partner = inv[ev.partner.index()];
+    if ev.kind() == Kind::Pair {
+        *ev = ev.with_partner(inv[ev.partner().index()]);
     }
 }
 

@@ -207,11 +207,7 @@ impl CellGrid {
             if t == f64::INFINITY {
                 return (f64::INFINITY, Event::default());
             }
-            let ev = Event {
-                kind: Kind::Relist,
-                ..Event::default()
-            };
-            return (t, ev);
+            return (t, Event::of(Kind::Relist, 0));
         }
         let coord = unpack(self.place[i.index()]);
         let last = self.per_side as u32 - 1;
@@ -232,12 +228,7 @@ impl CellGrid {
             best = [best, t][better as usize];
             mask = [mask, k as u8 | (up as u8) << 2][better as usize];
         }
-        let ev = Event {
-            kind: Kind::Cross,
-            mask,
-            ..Event::default()
-        };
-        (best, ev)
+        (best, Event::of(Kind::Cross, mask))
     }
 
     /// The cell small sphere `i` crosses into as `mask` says (a crossing's
