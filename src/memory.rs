@@ -5,14 +5,14 @@ use crate::physics::ModelKind;
 
 /// Peak bytes a sphere costs while a model steps headless (`bench`), with a
 /// quarter for margin (peak RSS at a million spheres less the empty process,
-/// the largest of packing 0.005, 0.1 and the dense preset: 194, 273 and 266
-/// B; docs/benchmarks.md has the runs).
+/// the largest of packing 0.005, 0.1 and the dense preset: for `exact` 188,
+/// 187 and 248 B; docs/benchmarks.md has the runs).
 pub fn sphere_bytes(model: ModelKind) -> u64 {
     match model {
         ModelKind::Discrete => 243,
         // `auto` may run any: the hungriest.
         ModelKind::Swept | ModelKind::Auto(_) => 342,
-        ModelKind::Exact => 333,
+        ModelKind::Exact => 310,
     }
 }
 
@@ -134,7 +134,7 @@ mod tests {
         assert!(check(1_000_000, Some(ModelKind::Swept), free).is_ok());
         let err = check(10_000_000, Some(ModelKind::Exact), free).unwrap_err();
         assert!(
-            err.starts_with("10000000 spheres would need about 3191 MiB"),
+            err.starts_with("10000000 spheres would need about 2972 MiB"),
             "{err}"
         );
         assert!(

@@ -252,7 +252,7 @@ fn tempdir() -> std::path::PathBuf {
 
 #[test]
 fn a_count_the_memory_cannot_hold_is_refused_with_the_figure() {
-    // Under a 400 MB address-space limit: a million spheres need about 333
+    // Under a 400 MB address-space limit: a million spheres need about 311
     // MiB with exact, more than the fixed cost and half of what the limit
     // leaves, so they are refused before the model allocates anything.
     let run = |model: &str| {
@@ -269,7 +269,7 @@ fn a_count_the_memory_cannot_hold_is_refused_with_the_figure() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
-        err.starts_with("ballpit: 1000000 spheres would need about 333 MiB")
+        err.starts_with("ballpit: 1000000 spheres would need about 311 MiB")
             && err.contains("with exact"),
         "{err}"
     );
