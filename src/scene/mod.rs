@@ -108,7 +108,7 @@ pub fn build_world_for(spec: &SceneSpec, model: Option<ModelKind>) -> Result<Wor
     let stdin = read_stdin(scene)?;
     let scene = if stdin.is_some() { "stdin" } else { scene };
     if has_extension(scene, "csv") || stdin.as_deref().is_some_and(looks_like_csv) {
-        return csv_world(spec, scene, stdin.as_deref(), overlaps);
+        return csv_world(spec, scene, stdin, overlaps);
     }
     let file = if has_extension(scene, "toml") || stdin.is_some() {
         Some(read_toml(scene, stdin.as_deref())?)
@@ -144,7 +144,7 @@ fn read_stdin(scene: &str) -> Result<Option<String>, BadInput> {
 fn csv_world(
     spec: &SceneSpec,
     scene: &str,
-    stdin: Option<&str>,
+    stdin: Option<String>,
     overlaps: place::Overlaps,
 ) -> Result<World, BadInput> {
     if spec.count.is_some() || spec.radius.is_some() || spec.speed.is_some() {
