@@ -45,17 +45,19 @@ pub fn split_big(bodies: &Bodies, factor: f64) -> Split {
         })
         .find(|&(seen, _)| seen > k)
         .map_or(0.0, |(_, r)| r);
-    let rmax = by_radius.last().map_or(0.0, |&s| radius(s));
+    split_at(bulk, by_radius.iter().map(|&s| radius(s)), factor)
+}
+
+/// The split once the bulk radius is known, from the scene's `radii` (each
+/// at least once, in any order).
+fn split_at(bulk: f64, radii: impl Iterator<Item = f64> + Clone, factor: f64) -> Split {
+    let rmax = radii.clone().fold(0.0, f64::max);
     let big_above = if rmax <= factor * bulk {
         f64::INFINITY
     } else {
         factor * bulk
     };
-    let small_rmax = by_radius
-        .iter()
-        .map(|&s| radius(s))
-        .filter(|&r| r <= big_above)
-        .fold(0.0, f64::max);
+    let small_rmax = radii.filter(|&r| r <= big_above).fold(0.0, f64::max);
     Split {
         bulk,
         big_above,
@@ -88,33 +90,18 @@ pub fn time_to_leave(d: DVec3, v: DVec3, r: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
-    use super::{Split, split_big};
+    use super::{Split, split_at, split_big};
     use crate::physics::exact::body::Bodies;
     use crate::physics::sphere::Sphere;
     use glam::DVec3;
 
-    /// What sorting every radius gives: the 98th percentile, the largest,
-    /// and the largest at or under the threshold.
+    /// What sorting every radius gives: the 98th percentile, then the same
+    /// rule for the threshold.
     fn by_sorting(radii: &[f64], factor: f64) -> Split {
         let mut sorted = radii.to_vec();
         sorted.sort_by(f64::total_cmp);
         let bulk = sorted[(radii.len() * 98 / 100).min(radii.len() - 1)];
-        let rmax = sorted[sorted.len() - 1];
-        let big_above = if rmax <= factor * bulk {
-            f64::INFINITY
-        } else {
-            factor * bulk
-        };
-        let small_rmax = sorted
-            .iter()
-            .copied()
-            .filter(|&r| r <= big_above)
-            .fold(0.0, f64::max);
-        Split {
-            bulk,
-            big_above,
-            small_rmax,
-        }
+        split_at(bulk, sorted.iter().copied(), factor)
     }
 
     fn bodies(radii: &[f64]) -> Bodies {
