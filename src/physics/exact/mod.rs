@@ -145,9 +145,12 @@ pub struct EventDriven<Q: EventQueue> {
     order: Vec<WorldId>,
     /// Cell mode: each sphere's best contact or wall event and its
     /// (absolute) time, kept apart from its crossing so a crossing rescans
-    /// only new cells, and which of the two the queue holds. Empty with
-    /// neighbour lists.
+    /// only new cells. Empty with neighbour lists.
     slots: Vec<Slot>,
+    /// Cell mode: which of its two events the queue holds for each sphere.
+    /// A byte apart from the slots (1 MB at a million, which stays in a
+    /// core's cache), so a crossing can read the next sphere's at once.
+    holds: Vec<Queued>,
     /// With neighbour lists: each sphere's event, whose time the queue
     /// alone keeps (8 bytes a sphere less than a slot). Empty in cell mode.
     events: Vec<Event>,
@@ -200,6 +203,7 @@ impl<Q: EventQueue> EventDriven<Q> {
             + self.order.capacity() * size_of::<WorldId>()
             + self.candidates.capacity() * size_of::<u32>()
             + self.slots.capacity() * size_of::<Slot>()
+            + self.holds.capacity() * size_of::<Queued>()
             + self.events.capacity() * size_of::<Event>()
             + self.queue.heap_bytes()
             + broad
@@ -272,7 +276,7 @@ impl<Q: EventQueue> EventDriven<Q> {
         }
         // The old broad phase and events go first, so a rebuild never holds two.
         self.broad = Broad::default();
-        (self.slots, self.events) = (Vec::new(), Vec::new());
+        (self.slots, self.holds, self.events) = (Vec::new(), Vec::new(), Vec::new());
         let filled: f64 = self
             .bodies
             .iter()
@@ -285,6 +289,7 @@ impl<Q: EventQueue> EventDriven<Q> {
             self.events = super::huge_pages::filled(n, Event::default());
         } else {
             self.slots = super::huge_pages::filled(n, Slot::default());
+            self.holds = super::huge_pages::filled(n, Queued::PENDING);
             let mut cells = Box::<CellGrid>::default();
             cells.build(&self.bodies, self.size, self.cells_per_sphere());
             self.broad = Broad::Cells(cells);
@@ -341,12 +346,8 @@ impl<Q: EventQueue> EventDriven<Q> {
                 }
                 let (t, ev) = p.finish();
                 let slot = &mut self.slots[i.index()];
-                *slot = Slot {
-                    t,
-                    ev,
-                    queued: Queued::PENDING,
-                };
-                with_crossing(cells, slot, i, a)
+                *slot = Slot { t, ev };
+                with_crossing(cells, slot, &mut self.holds[i.index()], i, a)
             }
         }
     }
@@ -372,7 +373,7 @@ impl<Q: EventQueue> EventDriven<Q> {
         }
         cells.cross(i, mask);
         if PF {
-            prefetch_next_crossing(cells, &self.slots, next);
+            prefetch_next_crossing(cells, &self.holds, next);
         }
         let (tp, evp) = self.slots[i.index()].pending();
         if evp.kind() == Kind::Pair && self.bodies[evp.partner()].count != evp.partner_count() {
@@ -386,12 +387,8 @@ impl<Q: EventQueue> EventDriven<Q> {
         }
         let (t, ev) = p.finish();
         let slot = &mut self.slots[i.index()];
-        *slot = Slot {
-            t,
-            ev,
-            queued: Queued::PENDING,
-        };
-        let t = with_crossing(cells, slot, i, a);
+        *slot = Slot { t, ev };
+        let t = with_crossing(cells, slot, &mut self.holds[i.index()], i, a);
         self.queue.update(i.index(), t);
     }
 
@@ -418,7 +415,7 @@ impl<Q: EventQueue> EventDriven<Q> {
     fn queued(&self, i: Label) -> Event {
         match self.broad {
             Broad::Lists(_) => self.events[i.index()],
-            Broad::Cells(_) => self.slots[i.index()].queued(),
+            Broad::Cells(_) => self.slots[i.index()].queued(self.holds[i.index()]),
         }
     }
 
@@ -554,8 +551,9 @@ impl<Q: EventQueue> EventDriven<Q> {
             self.queue.prefetch(k);
             match &self.broad {
                 Broad::Cells(cells) => {
-                    if let Some(slot) = self.slots.get(k) {
+                    if let (Some(slot), Some(holds)) = (self.slots.get(k), self.holds.get(k)) {
                         record(slot);
+                        line(holds);
                     }
                     cells.prefetch_place(k);
                 }
@@ -664,32 +662,39 @@ impl<Q: EventQueue + Send> Model for EventDriven<Q> {
 
 /// Cell mode: if sphere `next`'s queued event is a crossing, start loading
 /// the cells it will read. Called part-way through a crossing (after its
-/// gather and move): `next`'s slot was asked for as the crossing began and
-/// has arrived by then, so the next crossing's cells load while the rest
-/// of this one runs, a whole event before they are read. (In a contact or
-/// a wall event the slot has not arrived in time: docs/perf-log.md.)
+/// gather and move): `next`'s byte in `holds` was asked for as the
+/// crossing began and has arrived by then, so the next crossing's cells
+/// load while the rest of this one runs, a whole event before they are
+/// read. (In a contact or a wall event it has not arrived in time:
+/// docs/perf-log.md.)
 #[inline(always)]
-fn prefetch_next_crossing(cells: &CellGrid, slots: &[Slot], next: usize) {
-    if let Some(s) = slots.get(next) {
-        let q = s.queued;
-        if q.is_broad() && q.event().kind() == Kind::Cross {
-            cells.prefetch_cross(Label::at(next), q.event().mask());
-        }
+fn prefetch_next_crossing(cells: &CellGrid, holds: &[Queued], next: usize) {
+    if let Some(&q) = holds.get(next)
+        && q.is_broad()
+        && q.event().kind() == Kind::Cross
+    {
+        cells.prefetch_cross(Label::at(next), q.event().mask());
     }
 }
 
 /// Cell mode: the earlier of sphere `i`'s pending event (in `slot`) and
-/// its next crossing (the crossing first on a tie), marked in the slot;
+/// its next crossing (the crossing first on a tie), marked in `holds`;
 /// returns its time.
 #[inline]
-fn with_crossing(cells: &CellGrid, slot: &mut Slot, i: Label, a: &body::Body) -> f64 {
+fn with_crossing(
+    cells: &CellGrid,
+    slot: &Slot,
+    holds: &mut Queued,
+    i: Label,
+    a: &body::Body,
+) -> f64 {
     let (tc, ev) = cells.next_event(i, a);
     let tc = a.t + tc;
     let tp = slot.t;
     // By index: which comes first is random, and a branch on it
     // mispredicted a third of the time.
     let first = usize::from(tc <= tp);
-    slot.queued = [Queued::PENDING, Queued::broad(&ev)][first];
+    *holds = [Queued::PENDING, Queued::broad(&ev)][first];
     [tp, tc][first]
 }
 

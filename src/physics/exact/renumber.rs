@@ -110,6 +110,7 @@ impl<Q: EventQueue> EventDriven<Q> {
         // One of the two is empty: slots in cell mode, events with lists.
         if !self.slots.is_empty() {
             apply(&mut self.slots, &perm);
+            apply(&mut self.holds, &perm);
         }
         for slot in &mut self.slots {
             let mut ev = slot.ev;

@@ -141,16 +141,16 @@ impl Queued {
     }
 }
 
-/// What the loop keeps of a sphere's prediction in cell mode, 20 bytes:
-/// its best event other than a crossing and that event's absolute time, and
-/// whether the next crossing comes first (`queued`). With neighbour lists
-/// the loop keeps the [`Event`] alone: its time is the queue's.
+/// What the loop keeps of a sphere's prediction in cell mode, 16 bytes:
+/// its best event other than a crossing and that event's absolute time
+/// (whether the next crossing comes first is a [`Queued`] kept apart).
+/// With neighbour lists the loop keeps the [`Event`] alone: its time is
+/// the queue's.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, packed(4))]
 pub struct Slot {
     pub t: f64,
     pub ev: Event,
-    pub queued: Queued,
 }
 
 impl Default for Slot {
@@ -158,16 +158,15 @@ impl Default for Slot {
         Slot {
             t: f64::INFINITY,
             ev: Event::default(),
-            queued: Queued::PENDING,
         }
     }
 }
 
 impl Slot {
-    /// The event the queue holds for this sphere.
+    /// The event the queue holds for this sphere, as `queued` says.
     #[inline]
-    pub fn queued(self) -> Event {
-        let (ev, queued) = (self.ev, self.queued);
+    pub fn queued(self, queued: Queued) -> Event {
+        let ev = self.ev;
         // By index: which of the two it is is random (see `with_crossing`).
         [ev, queued.event()][usize::from(queued.is_broad())]
     }
@@ -307,9 +306,9 @@ mod tests {
     use super::*;
 
     #[test]
-    fn an_event_is_8_bytes_and_a_slot_20() {
+    fn an_event_is_8_bytes_and_a_slot_16() {
         let sizes = [size_of::<Event>(), size_of::<Slot>(), size_of::<Queued>()];
-        assert_eq!(sizes, [8, 20, 1], "Event, Slot, Queued");
+        assert_eq!(sizes, [8, 16, 1], "Event, Slot, Queued");
     }
 
     /// Every kind, mask and partner (up to the largest) reads back.
