@@ -69,9 +69,10 @@ pub fn parse_with(
             bad_input!("{name} line {line}: {e}")
         })?;
         let start = rec.position().map_or(0, csv::Position::byte);
-        spheres.push(sphere_of(&rec, name, || line_at(&text, start))?);
+        let line = at.line_of(&text, start);
+        spheres.push(sphere_of(&rec, name, line)?);
         // At most MAX_COUNT rows and some blank lines: a u32 holds the line.
-        lines.push(u32::try_from(at.line_of(&text, start)).unwrap_or(u32::MAX));
+        lines.push(u32::try_from(line).unwrap_or(u32::MAX));
     }
     drop(rdr);
     drop(text);
@@ -140,16 +141,12 @@ fn first_in_line(text: &str, byte: u64) -> usize {
     start + skip
 }
 
-/// The sphere of one row, or what is wrong with it at `line()`.
-fn sphere_of(
-    rec: &csv::StringRecord,
-    name: &str,
-    line: impl Fn() -> usize,
-) -> Result<Sphere, BadInput> {
+/// The sphere of one row, or what is wrong with it at `line`.
+fn sphere_of(rec: &csv::StringRecord, name: &str, line: usize) -> Result<Sphere, BadInput> {
     if rec.len() != 8 {
         return bad!(
             "{name} line {}: expected 8 fields, found {}",
-            line(),
+            line,
             rec.len()
         );
     }
@@ -158,7 +155,7 @@ fn sphere_of(
         *slot = field.parse().map_err(|_| {
             bad_input!(
                 "{name} line {}: {} = `{field}` is not a number",
-                line(),
+                line,
                 HEADER[k]
             )
         })?;

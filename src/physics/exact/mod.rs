@@ -344,10 +344,8 @@ impl<Q: EventQueue> EventDriven<Q> {
                         p.pair(Label::from_raw(j));
                     }
                 }
-                let (t, ev) = p.finish();
                 let slot = &mut self.slots[i.index()];
-                *slot = Slot { t, ev };
-                with_crossing(cells, slot, &mut self.holds[i.index()], i, a)
+                with_crossing(cells, slot, &mut self.holds[i.index()], p.finish(), i, a)
             }
         }
     }
@@ -385,10 +383,8 @@ impl<Q: EventQueue> EventDriven<Q> {
         for &j in &self.candidates[..n] {
             p.pair(Label::from_raw(j));
         }
-        let (t, ev) = p.finish();
         let slot = &mut self.slots[i.index()];
-        *slot = Slot { t, ev };
-        let t = with_crossing(cells, slot, &mut self.holds[i.index()], i, a);
+        let t = with_crossing(cells, slot, &mut self.holds[i.index()], p.finish(), i, a);
         self.queue.update(i.index(), t);
     }
 
@@ -677,20 +673,21 @@ fn prefetch_next_crossing(cells: &CellGrid, holds: &[Queued], next: usize) {
     }
 }
 
-/// Cell mode: the earlier of sphere `i`'s pending event (in `slot`) and
-/// its next crossing (the crossing first on a tie), marked in `holds`;
-/// returns its time.
+/// Cell mode: sphere `i`'s pending event `(tp, pending)` kept in `slot`,
+/// and the earlier of it and its next crossing (the crossing first on a
+/// tie) marked in `holds`; returns that one's time.
 #[inline]
 fn with_crossing(
     cells: &CellGrid,
-    slot: &Slot,
+    slot: &mut Slot,
     holds: &mut Queued,
+    (tp, pending): (f64, Event),
     i: Label,
     a: &body::Body,
 ) -> f64 {
+    *slot = Slot { t: tp, ev: pending };
     let (tc, ev) = cells.next_event(i, a);
     let tc = a.t + tc;
-    let tp = slot.t;
     // By index: which comes first is random, and a branch on it
     // mispredicted a third of the time.
     let first = usize::from(tc <= tp);

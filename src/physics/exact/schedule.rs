@@ -147,7 +147,6 @@ impl Queued {
 /// With neighbour lists the loop keeps the [`Event`] alone: its time is
 /// the queue's.
 #[derive(Clone, Copy, Debug)]
-#[repr(C, packed(4))]
 pub struct Slot {
     pub t: f64,
     pub ev: Event,
