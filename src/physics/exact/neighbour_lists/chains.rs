@@ -71,6 +71,7 @@ impl CellChains {
     }
 
     /// Sphere `i` from cell `from` to cell `to`, first there.
+    #[inline]
     pub fn move_to(&mut self, i: Label, from: Cell, to: Cell) {
         self.remove(i, from);
         self.insert(i, to);
