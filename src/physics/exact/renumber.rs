@@ -95,6 +95,7 @@ impl<Q: EventQueue> EventDriven<Q> {
     /// Sort the spheres by cell again (their positions at their own time
     /// stamps), moving every per-sphere record with its sphere.
     pub(super) fn renumber(&mut self) {
+        let start = std::time::Instant::now();
         let perm = spatial_order(
             self.bodies.iter().map(|b: &Body| b.pos),
             self.size,
@@ -133,6 +134,8 @@ impl<Q: EventQueue> EventDriven<Q> {
         }
         self.queue.rebuild();
         self.stats.renumberings += 1;
+        let took = u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX);
+        self.stats.renumber_nanos = self.stats.renumber_nanos.saturating_add(took);
     }
 }
 
