@@ -36,12 +36,14 @@
 //! the load sorted them; and the relabelled model's rate without the time
 //! its relabelling took (what the order buys the loop if keeping it were
 //! free: an upper bound for storing spheres by place).
-//! `exact-queues N packing rounds [steps] [calendar]`: one scene, the exact
+//! `exact-queues N packing rounds [steps] [calendar] [noprefetch]`: one scene, the exact
 //! model over today's event queue (the eight-way tournament) and another
 //! (the binary tournament, or with `calendar` the calendar), on copies of the world
 //! in blocks of `steps` steps of 2 ms (default 20), timed in alternation:
 //! events per second of each, and each queue's heap bytes a sphere. The
 //! two must process the same events: the counts are compared at the end.
+//! With `noprefetch` neither prefetches (only the eight-way tree names a
+//! runner-up, so this compares the queues alone).
 //!
 //! With `sorted`, both worlds are sorted in space (by cell of the 10k
 //! scene's grid, z then y then x) before every block, outside the timing:
@@ -251,8 +253,14 @@ fn exact_queues_with<Q: EventQueue + Send>(args: &[String], name: &str) {
     let (n, packing, rounds, steps) = side_by_side_args(args);
     let world = exact_scene(n, packing);
     let (mut wt, mut wc) = (world.clone(), world);
-    let mut tree = Exact::default();
-    let mut other = EventDriven::<Q>::default();
+    // Only the eight-way tree names a runner-up to prefetch for: with
+    // `noprefetch` neither model prefetches, and the queues are compared
+    // on equal terms.
+    let (mut tree, mut other) = (Exact::default(), EventDriven::<Q>::default());
+    if args.iter().any(|a| a == "noprefetch") {
+        tree = tree.with_prefetching(false);
+        other = other.with_prefetching(false);
+    }
     tree.advance(&mut wt, 1e-9, 1, &Serial);
     other.advance(&mut wc, 1e-9, 1, &Serial);
     let (mut total, mut spent) = ([0u64; 2], [0f64; 2]);
