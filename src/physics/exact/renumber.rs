@@ -114,9 +114,7 @@ impl<Q: EventQueue> EventDriven<Q> {
             apply(&mut self.holds, &perm);
         }
         for slot in &mut self.slots {
-            let mut ev = slot.ev;
-            relabel(&mut ev, &inv);
-            slot.ev = ev;
+            relabel(&mut slot.ev, &inv);
         }
         if !self.events.is_empty() {
             apply(&mut self.events, &perm);
