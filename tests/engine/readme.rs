@@ -156,7 +156,9 @@ fn doc_files() -> Vec<PathBuf> {
 fn every_link_between_the_docs_lands() {
     let files = doc_files();
     assert!(
-        files.iter().any(|f| f.ends_with("docs/history/2026-11-22.md")),
+        files
+            .iter()
+            .any(|f| f.ends_with("docs/history/2026-11-22.md")),
         "the walk reaches docs/history/"
     );
     let mut checked = 0;
