@@ -111,7 +111,7 @@ fn the_parser_reads_commands_groups_and_flags() {
               \x20            --seed S\n\
               ```\n\n## Next\n";
     let got = synopsis(md);
-    let set = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<BTreeSet<_>>();
+    let set = |v: &[&str]| v.iter().map(ToString::to_string).collect::<BTreeSet<_>>();
     assert_eq!(got[""], set(&["count", "fps", "scene", "seed"]));
     assert_eq!(got["bench"], set(&["count", "scene", "seed", "steps"]));
     assert_eq!(got["man"], set(&[]));
