@@ -10,7 +10,7 @@ use std::ops::Range;
 /// Keys per range of the parallel form, at least.
 const RANGE_KEYS: usize = 1024;
 /// Source items per block of the parallel form, at least.
-const ITEM_BLOCK: usize = 4096;
+const ITEM_BLOCK: usize = 2048;
 
 /// The parallel form's buckets: by block of the source, by range of keys,
 /// the (key, item) pairs in source order. Kept to reuse their memory.

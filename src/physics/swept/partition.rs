@@ -327,7 +327,7 @@ impl Partition {
         } else if first {
             self.partition_all(exec, meets, batch);
         } else {
-            self.partition_dirty(meets, batch);
+            self.partition_dirty(exec, meets, batch);
         }
     }
 
@@ -359,7 +359,7 @@ impl Partition {
             self.partition_wide(exec, meets, batch);
             return;
         }
-        self.index_meets(meets);
+        self.index_meets(exec, meets);
         // Every cluster, by root (a root is its own parent), walked round
         // its cycle.
         for root in (0..self.ids.len()).map(Slot::at) {
@@ -374,7 +374,9 @@ impl Partition {
     /// sphere order, in the first round) and its meeting pairs in detection
     /// order, as the slots and the pairs grouped by their root.
     fn partition_wide(&mut self, exec: &dyn Exec, meets: &[(u32, u32)], batch: &mut Batch) {
-        self.find_roots(exec);
+        let mut roots = std::mem::take(&mut self.roots);
+        self.roots_into(exec, &mut roots);
+        self.roots = roots;
         let m = self.ids.len();
         let (roots, ids, meet_slot) = (&self.roots, &self.ids, &self.meet_slot);
         let members = |r: std::ops::Range<usize>| r.map(|s| (roots[s].0, ids[s]));
@@ -407,14 +409,18 @@ impl Partition {
         }
     }
 
-    /// Every slot's root, in parallel blocks, each slot climbing on its own.
-    fn find_roots(&mut self, exec: &dyn Exec) {
+    /// Every slot's root into `out`: on many lanes in parallel blocks, each
+    /// slot climbing on its own; else by `find`.
+    pub fn roots_into(&mut self, exec: &dyn Exec, out: &mut Vec<Slot>) {
         let m = self.ids.len();
-        self.roots.clear();
-        self.roots.resize(m, Slot::NONE);
+        out.clear();
+        if !(wide(exec) && m >= 2 * ROOT_BLOCK.min(exec.min_work())) {
+            out.extend((0..m).map(|s| self.find(Slot::at(s))));
+            return;
+        }
+        out.resize(m, Slot::NONE);
         let parent = &self.parent;
-        let chunks: Vec<Mutex<&mut [Slot]>> =
-            self.roots.chunks_mut(ROOT_BLOCK).map(Mutex::new).collect();
+        let chunks: Vec<Mutex<&mut [Slot]>> = out.chunks_mut(ROOT_BLOCK).map(Mutex::new).collect();
         for_each_block(exec, chunks.len(), &|b| {
             for (k, r) in chunks[b].lock().iter_mut().enumerate() {
                 let mut x = Slot::at(b * ROOT_BLOCK + k);
@@ -428,19 +434,33 @@ impl Partition {
 
     /// Each first-round slot's meeting pairs (as the pair's first sphere),
     /// once a round after the first needs them.
-    fn index_meets(&mut self, meets: &[(u32, u32)]) {
+    fn index_meets(&mut self, exec: &dyn Exec, meets: &[(u32, u32)]) {
         debug_assert_eq!(self.meet_slot.len(), meets.len());
         if self.meets_indexed {
             return;
         }
         self.meets_indexed = true;
+        let (starts, out) = (&mut self.meet_start, &mut self.meets_of);
+        if wide_group(exec, self.first_late, meets.len()) {
+            let slots = &self.meet_slot;
+            let by_slot = |r: std::ops::Range<usize>| {
+                let from = r.start as u32;
+                slots[r].iter().map(|s| s.0).zip(from..)
+            };
+            let buckets = &mut self.ids_buckets;
+            group_wide(
+                exec,
+                buckets,
+                starts,
+                out,
+                self.first_late,
+                meets.len(),
+                &by_slot,
+            );
+            return;
+        }
         let by_slot = self.meet_slot.iter().map(|s| s.0).zip(0..);
-        group(
-            &mut self.meet_start,
-            &mut self.meets_of,
-            self.first_late,
-            by_slot,
-        );
+        group(starts, out, self.first_late, by_slot);
     }
 
     /// Cluster `root` as a run to make: its members in sphere order and its
@@ -480,8 +500,8 @@ impl Partition {
     /// The clusters marked dirty since the last partition, each with its
     /// members in sphere order and its meeting pairs in detection order
     /// (as the first round has them), in order of their roots.
-    fn partition_dirty(&mut self, meets: &[(u32, u32)], batch: &mut Batch) {
-        self.index_meets(meets);
+    fn partition_dirty(&mut self, exec: &dyn Exec, meets: &[(u32, u32)], batch: &mut Batch) {
+        self.index_meets(exec, meets);
         let mut roots = std::mem::take(&mut self.dirty_roots);
         for r in &mut roots {
             *r = self.find(*r);
