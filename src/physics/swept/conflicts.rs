@@ -193,7 +193,7 @@ impl Conflicts {
     /// grown balls, or any ball and that of a bystander that joined a run (which
     /// other runs took to fly straight), may meet where no run could see
     /// it: such pairs in different clusters are compared by their paths.
-    #[allow(clippy::too_many_arguments)]
+    #[allow(clippy::too_many_arguments)] // borrows of separate owners (the partition, the finished paths, the spheres), not one value
     pub fn check_grown(
         &mut self,
         exec: &dyn Exec,

@@ -88,7 +88,7 @@ pub(super) fn pair_event(t: f64, a: u32, b: u32, la: Local, lb: Local, ca: u32, 
 }
 
 /// `s`'s next wall event, if it falls within the step.
-#[allow(clippy::too_many_arguments)]
+#[allow(clippy::too_many_arguments)] // one sphere's event stamp (ids, time, count) and the box: values the hot loop already holds
 pub(super) fn push_wall(
     heap: &mut BinaryHeap<Event>,
     s: &Sphere,

@@ -108,7 +108,7 @@ impl Rounds {
     /// The runs may do `budget` work in all, each round's split over its
     /// runs by their members (so not by lanes); [`Rounds::work`] says how
     /// much they did.
-    #[allow(clippy::too_many_arguments)]
+    #[allow(clippy::too_many_arguments)] // the step's inputs, each a borrow of a different owner in `Swept::advance`
     pub fn run(
         &mut self,
         exec: &dyn Exec,
