@@ -67,6 +67,7 @@ mod renumber;
 pub mod schedule;
 mod spatial;
 mod species;
+mod sync;
 #[cfg(feature = "experiments")]
 mod tournament;
 
@@ -236,40 +237,6 @@ impl<Q: EventQueue> EventDriven<Q> {
         return self.hooks.cells_per_sphere();
         #[cfg(not(feature = "experiments"))]
         cell_grid::CELLS_PER_SPHERE
-    }
-
-    /// Whether `world` is the one we last wrote, untouched since: its
-    /// generation (every edit from outside a model calls `World::touch`),
-    /// time, size and count are those of our write-back. The edit signal
-    /// is the generation alone, as for `swept`: no pass over the spheres.
-    fn matches(&self, world: &World) -> bool {
-        self.valid
-            && world.generation() == self.synced_generation
-            && world.size == self.size
-            && world.time == self.synced_time
-            && world.spheres.len() == self.bodies.len()
-    }
-
-    fn load(&mut self, world: &World) {
-        // An event names its partner in 26 bits; a scene holds at most 10^7.
-        assert!(
-            world.spheres.len() <= schedule::MAX_SPHERES,
-            "exact takes at most {} spheres",
-            schedule::MAX_SPHERES
-        );
-        self.size = world.size;
-        self.origin = world.time;
-        self.synced_time = world.time;
-        self.synced_generation = world.generation();
-        let positions = world.spheres.iter().map(|s| s.pos);
-        self.order = spatial::spatial_order(positions, world.size, WorldId::at);
-        self.bodies =
-            Bodies::from_spheres(self.order.iter().map(|&k| &world.spheres[k.index()]), 0.0);
-        #[cfg(feature = "experiments")]
-        {
-            self.hooks.sorted_at = self.stats.crossings + self.stats.relists;
-        }
-        self.reschedule_all();
     }
 
     /// New neighbour lists and a prediction for every sphere, at the bodies'
@@ -525,18 +492,6 @@ impl<Q: EventQueue> EventDriven<Q> {
             let b = &mut self.bodies[i];
             (b.pos, b.vel, b.t) = (s.pos, s.vel, target);
         }
-    }
-
-    fn write_back(&mut self, world: &mut World) {
-        let now = world.time - self.origin;
-        for (&k, b) in self.order.iter().zip(self.bodies.iter_mut()) {
-            b.advance(now);
-            let s = &mut world.spheres[k.index()];
-            s.pos = b.pos;
-            s.vel = b.vel;
-        }
-        self.synced_time = world.time;
-        self.synced_generation = world.generation();
     }
 }
 
