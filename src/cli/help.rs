@@ -141,7 +141,10 @@ pub(super) fn scaling_after_help() -> String {
     format!(
         "Without --scene: {} spheres of the gas at packing {} (--count N keeps the packing \
          unless --radius is given). With --out DIR it also writes DIR/scaling.csv (columns: {}) \
-         and DIR/scaling.svg (speed-up against threads, with the fit's prediction).\n\n\
+         and DIR/scaling.svg (speed-up against threads, with the fit's prediction). --lanes \
+         P,P,… adds, for each P, the work and span of the same steps on P lanes run one after \
+         another on this thread: the speed-up P cores would give, predicted from work and span \
+         on this machine.\n\n\
          Example: ballpit scaling --out /tmp/scaling",
         super::SCALING_COUNT,
         super::SCALING_PACKING,

@@ -136,6 +136,10 @@ pub struct ScalingArgs {
     /// (0 < S <= 600)
     #[arg(long, default_value = "1", value_name = "S", value_parser = values::parse_run_seconds)]
     pub seconds: f64,
+    /// Lane counts to predict for from work and span, comma-separated (1 to 1024)
+    #[arg(long, default_value = "16,64,128", value_name = "P,P,…",
+          value_parser = crate::scaling::parse_lanes)]
+    pub lanes: crate::scaling::Lanes,
     /// Write scaling.csv and scaling.svg into this directory
     #[arg(long, value_name = "DIR", value_hint = clap::ValueHint::DirPath)]
     pub out: Option<PathBuf>,
@@ -174,6 +178,7 @@ impl ScalingArgs {
             rounds: self.rounds,
             seconds: self.seconds,
             cores,
+            lanes: self.lanes.0.clone(),
         }
     }
 }

@@ -9,7 +9,7 @@ mod task;
 
 pub use role::ThreadRole;
 
-pub use task::{current_tid, thread_cpu_seconds_of};
+pub use task::{current_tid, thread_cpu_ns, thread_cpu_seconds_of};
 
 use history::History;
 use machine::Others;

@@ -36,6 +36,14 @@ pub fn thread_cpu_seconds_of(tid: i32) -> Option<f64> {
     Some(tick_seconds(procfs::task_stat_ticks(tid)?))
 }
 
+/// Nanoseconds of CPU the calling thread has run (its own CPU clock,
+/// `CLOCK_THREAD_CPUTIME_ID`): exact at any moment, unlike schedstat,
+/// which a running thread's reader sees only up to the last tick.
+pub fn thread_cpu_ns() -> u64 {
+    let t = rustix::time::clock_gettime(rustix::time::ClockId::ThreadCPUTime);
+    u64::try_from(t.tv_sec).unwrap_or(0) * 1_000_000_000 + u64::try_from(t.tv_nsec).unwrap_or(0)
+}
+
 /// Clock ticks of a `stat` time in seconds.
 fn tick_seconds(ticks: u64) -> f64 {
     ticks as f64 / ticks_per_second()

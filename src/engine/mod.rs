@@ -17,11 +17,13 @@
 mod frame;
 mod pool;
 mod snapshot;
+mod span;
 mod start;
 mod worker;
 
 pub use pool::{KEPT_WORKER, PoolExec, Refused, SPLIT_ROLES, SplitExec, kept_pool, pool_name};
 pub use snapshot::{Snapshot, SphereView};
+pub use span::{SpanExec, WorkSpan, makespan};
 pub use start::Rebuild;
 
 use crate::cpu::ThreadRole;

@@ -51,6 +51,16 @@ pub trait Exec: Sync {
     fn take_busy(&self) -> Option<Busy> {
         None
     }
+    /// Run `f(lane, block)` for every block in `0..blocks` on `lanes` lanes
+    /// (as `lanes_of` gave them), each lane taking the next block from a
+    /// shared counter as it finishes one. An executor that times blocks
+    /// (the span executor) deals them itself.
+    fn for_blocks(&self, lanes: usize, blocks: usize, f: &(dyn Fn(usize, usize) + Sync)) {
+        let next = AtomicUsize::new(0);
+        self.for_lanes(lanes, &|lane| {
+            next_blocks(&next, blocks).for_each(|b| f(lane, b));
+        });
+    }
 }
 
 /// Items of work (spheres, pairs, cluster members) a lane must have before
@@ -162,8 +172,7 @@ pub fn for_each_block(exec: &dyn Exec, blocks: usize, f: &(dyn Fn(usize) + Sync)
 /// own, so who ran it never shows.
 pub fn for_each_block_of(exec: &dyn Exec, blocks: usize, work: usize, f: &(dyn Fn(usize) + Sync)) {
     let lanes = lanes_of(exec, blocks, work);
-    let next = AtomicUsize::new(0);
-    exec.for_lanes(lanes, &|_| next_blocks(&next, blocks).for_each(f));
+    exec.for_blocks(lanes, blocks, &|_, b| f(b));
 }
 
 /// The blocks one lane takes from a shared counter, until none are left.

@@ -15,10 +15,15 @@
 //! Karp–Flatt fraction of its speed-up (none where there is no speed-up).
 //! One Amdahl fit of the pool's speed-ups then predicts 16, 64 and 128
 //! cores. A scene whose sections never get a second lane is said so.
+//! Then, for each of `--lanes`, the work and span of the same steps on that
+//! many lanes (see `span`): what a machine of that many cores would give,
+//! predicted from work and span on this one.
 mod fit;
 mod report;
+mod span;
 
 pub use report::{CSV_COLUMNS, csv, markdown, svg};
+pub use span::{DEFAULT_LANES, Lanes, MAX_LANES, SpanRow, parse_lanes};
 
 use crate::bench;
 use crate::engine::{MAX_THREADS, Settings, Threading};
@@ -77,8 +82,8 @@ pub fn configs(top: usize) -> Vec<Config> {
 }
 
 /// What the sweep runs: the scene's model and step, the largest pool,
-/// rounds, and how long an `off` run should take.
-#[derive(Clone, Copy, Debug)]
+/// rounds, how long an `off` run should take, and the lanes to predict for.
+#[derive(Clone, Debug)]
 pub struct Plan {
     pub model: ModelKind,
     pub dt: f64,
@@ -86,6 +91,7 @@ pub struct Plan {
     pub rounds: usize,
     pub seconds: f64,
     pub cores: usize,
+    pub lanes: Vec<usize>,
 }
 
 /// One configuration's figures over the rounds.
@@ -129,6 +135,8 @@ pub struct Sweep {
     /// Why no configuration can beat `off` here, when a probe of a pool
     /// found no section with a second lane.
     pub nothing_to_share: Option<String>,
+    /// Work and span on each of `plan.lanes`.
+    pub spans: Vec<SpanRow>,
 }
 
 impl Sweep {
@@ -191,6 +199,19 @@ pub fn measure(
             done += 1;
         }
     }
+    let reference = reference.unwrap_or_else(|| world.clone());
+    let tick = settings(plan, configs[0], steps).tick;
+    let spans = span::rows(
+        world,
+        plan,
+        steps,
+        u64::from(tick),
+        &reference,
+        &mut |next| {
+            progress(done, next);
+            done += 1;
+        },
+    );
     let rows = rows(&configs, &runs, plan.cores);
     // Amdahl's law is about processors: an oversubscribed pool adds queueing,
     // not serial work, so it is shown but not fitted.
@@ -204,7 +225,7 @@ pub fn measure(
         .collect();
     let measured = median(fitted.iter().filter_map(|r| r.serial_measured).collect());
     Ok(Sweep {
-        plan: *plan,
+        plan: plan.clone(),
         n: world.spheres.len(),
         packing: crate::physics::relax::packing(&world.spheres, world.size),
         steps,
@@ -216,6 +237,7 @@ pub fn measure(
         fitted: fit::fit(&points),
         measured,
         nothing_to_share,
+        spans,
     })
 }
 
@@ -365,7 +387,7 @@ pub fn run(world: &World, plan: &Plan, out: Option<&Path>) -> anyhow::Result<Str
             crate::error::BadInput(format!("cannot create directory {}: {e}", dir.display()))
         })?;
     }
-    let runs = 1 + configs(plan.top).len() * plan.rounds;
+    let runs = 1 + configs(plan.top).len() * plan.rounds + plan.lanes.len();
     let bar = crate::progress::Progress::new(runs);
     let sweep = measure(world, plan, &mut |done, next| bar.set(done, next));
     bar.finish();

@@ -1,5 +1,5 @@
 //! The sweep as a markdown table, a CSV and an SVG plot.
-use super::{Row, Sweep, fit};
+use super::{Row, SpanRow, Sweep, fit};
 use crate::engine::Threading;
 use anyhow::Context;
 use plotters::prelude::*;
@@ -83,7 +83,40 @@ pub fn markdown(s: &Sweep) -> String {
     }
     out.push('\n');
     notes(s, &mut out);
+    spans(s, &mut out);
     out
+}
+
+/// The work and span table: what many more lanes would give, labelled as
+/// the prediction it is.
+fn spans(s: &Sweep, out: &mut String) {
+    if s.spans.is_empty() {
+        return;
+    }
+    let off_cpu = s.rows.first().map_or(0.0, |r| r.physics_cpu_seconds);
+    let _ = write!(
+        out,
+        "\nPredicted from work and span on this machine, not measured: the same {} steps on a pool of P lanes run one after another on one thread, every lane of every section timed with the thread's CPU clock and its blocks dealt as the pool deals them. Hand-offs cost nothing here and the lanes share no memory bandwidth, so a real machine of P cores gives less.\n\n\
+         | lanes | work s | work over off's CPU | span s | parallelism (work/span∞) | predicted speed-up (work/span) | Brent's bound | same bits |\n\
+         |---:|---:|---:|---:|---:|---:|---:|---|\n",
+        s.steps
+    );
+    for r in &s.spans {
+        let m = &r.measured;
+        let over = if off_cpu > 0.0 { m.work / off_cpu } else { 0.0 };
+        let _ = writeln!(
+            out,
+            "| {} | {:.3} | {:.2}× | {:.4} | {:.1} | {:.1}× | {:.1}× | {} |",
+            r.lanes,
+            m.work,
+            over,
+            m.span,
+            r.parallelism(),
+            r.predicted_speedup(),
+            r.brent(),
+            if r.same_bits { "yes" } else { "NO" },
+        );
+    }
 }
 
 /// Below the table: a busy host, runs that ended in other bits, the fit
@@ -140,8 +173,10 @@ fn notes(s: &Sweep, out: &mut String) {
 }
 
 /// The CSV's columns; `mode` is `predicted` on the rows of the fit's
-/// predictions (only `threads`, `processors` and `speedup` filled in).
-pub const CSV_COLUMNS: [&str; 14] = [
+/// predictions (only `threads`, `processors` and `speedup` filled in), and
+/// `span` on the rows predicted from work and span (`threads` the lanes,
+/// `speedup` work/span, with the work, span and parallelism).
+pub const CSV_COLUMNS: [&str; 17] = [
     "mode",
     "threads",
     "processors",
@@ -156,6 +191,9 @@ pub const CSV_COLUMNS: [&str; 14] = [
     "serial_measured",
     "karp_flatt",
     "same_bits",
+    "work_seconds",
+    "span_seconds",
+    "parallelism",
 ];
 
 /// The rows as CSV, numbers in `{:e}` form as `tradeoff.csv` has them.
@@ -184,6 +222,9 @@ pub fn csv(s: &Sweep) -> anyhow::Result<String> {
             oe(r.serial_measured),
             oe(r.karp_flatt),
             r.same_bits.to_string(),
+            String::new(),
+            String::new(),
+            String::new(),
         ];
         w.write_record(&fields)?;
     }
@@ -193,6 +234,19 @@ pub fn csv(s: &Sweep) -> anyhow::Result<String> {
         fields[1] = cores.to_string();
         fields[2] = cores.to_string();
         fields[7] = e(speedup);
+        w.write_record(&fields)?;
+    }
+    for r in &s.spans {
+        let mut fields: [String; CSV_COLUMNS.len()] = Default::default();
+        fields[0] = "span".into();
+        fields[1] = r.lanes.to_string();
+        fields[2] = r.lanes.to_string();
+        fields[3] = s.steps.to_string();
+        fields[7] = e(r.predicted_speedup());
+        fields[13] = r.same_bits.to_string();
+        fields[14] = e(r.measured.work);
+        fields[15] = e(r.measured.span);
+        fields[16] = e(r.parallelism());
         w.write_record(&fields)?;
     }
     let bytes = w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?;
@@ -257,6 +311,26 @@ pub fn svg(s: &Sweep, path: &Path) -> anyhow::Result<()> {
             .label(format!("{mode}, measured"))
             .legend(move |(x, y)| Cross::new((x + 10, y), 5, colour));
     }
+    if !s.spans.is_empty() {
+        let pts: Vec<(f64, f64)> = s
+            .spans
+            .iter()
+            .map(|r| (r.lanes as f64, r.predicted_speedup()))
+            .collect();
+        chart
+            .draw_series(DashedLineSeries::new(
+                pts.clone(),
+                4,
+                3,
+                CYAN.stroke_width(2),
+            ))?
+            .label("pool, predicted from work and span on this machine")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], CYAN));
+        chart.draw_series(
+            pts.iter()
+                .map(|&p| TriangleMarker::new(p, 5, CYAN.filled())),
+        )?;
+    }
     if let Some(f) = s.fitted {
         let curve: Vec<(f64, f64)> = (0..=70)
             .map(|i| {
@@ -287,6 +361,7 @@ fn extent(s: &Sweep) -> (f64, f64, f64) {
         .iter()
         .map(|r| r.config.threads)
         .chain(fit::PREDICT_AT)
+        .chain(s.spans.iter().map(|r| r.lanes))
         .max()
         .unwrap_or(2) as f64;
     let ymax = s
@@ -294,6 +369,7 @@ fn extent(s: &Sweep) -> (f64, f64, f64) {
         .iter()
         .map(|r| r.speedup)
         .chain(s.predictions().iter().map(|p| p.1))
+        .chain(s.spans.iter().map(SpanRow::predicted_speedup))
         .fold(2.0f64, f64::max);
     let ymin = s
         .rows

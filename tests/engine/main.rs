@@ -21,5 +21,6 @@ mod readme;
 mod scaling;
 mod scene_files;
 mod scenes;
+mod span;
 mod synopsis;
 mod timer;

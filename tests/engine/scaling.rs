@@ -68,11 +68,15 @@ fn a_tiny_sweep_prints_every_column_and_writes_csv_and_svg() {
     }
     // A row per configuration: off, worker, split, pools of 1, 2 and 4.
     let sweep = configs(2);
-    let rows: Vec<&str> = table
+    let (measured_table, span_table) = table
+        .split_once("Predicted from work and span on this machine, not measured")
+        .expect("the work and span table");
+    let rows: Vec<&str> = measured_table
         .lines()
         .filter(|l| l.starts_with("| ") && !l.starts_with("| mode"))
         .collect();
     assert_eq!(rows.len(), sweep.len(), "{table}");
+    work_and_span_rows(span_table);
     for (row, c) in rows.iter().zip(&sweep) {
         let cells: Vec<&str> = row.split('|').map(str::trim).collect();
         assert_eq!(cells[1], c.threading.name(), "{row}");
@@ -94,7 +98,11 @@ fn a_tiny_sweep_prints_every_column_and_writes_csv_and_svg() {
     assert_eq!(lines.next().unwrap(), CSV_COLUMNS.join(","));
     let body: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert!(body.iter().all(|r| r.len() == CSV_COLUMNS.len()), "{csv}");
-    let measured: Vec<&Vec<&str>> = body.iter().filter(|r| r[0] != "predicted").collect();
+    let measured: Vec<&Vec<&str>> = body
+        .iter()
+        .filter(|r| r[0] != "predicted" && r[0] != "span")
+        .collect();
+    work_and_span_csv(&body, &csv);
     assert_eq!(measured.len(), sweep.len(), "{csv}");
     assert!(measured.iter().all(|r| r[13] == "true"), "same bits: {csv}");
     fractions_within_0_and_1(&measured, &csv);
@@ -103,7 +111,7 @@ fn a_tiny_sweep_prints_every_column_and_writes_csv_and_svg() {
         .filter(|r| r[0] == Threading::Pool.name())
         .count();
     assert_eq!(pools, 3, "{csv}");
-    let predicted = body.len() - measured.len();
+    let predicted = body.iter().filter(|r| r[0] == "predicted").count();
     assert_eq!(predicted, if cores() >= 2 { 3 } else { 0 }, "{csv}");
     if cores() >= 2 {
         the_fit_lies_among_the_pools_fractions(&table, &body);
@@ -117,7 +125,47 @@ fn a_tiny_sweep_prints_every_column_and_writes_csv_and_svg() {
         "{svg:.200}"
     );
     assert!(svg.contains("pool, measured"), "{svg:.200}");
+    assert!(
+        svg.contains("predicted from work and span on this machine"),
+        "{svg:.200}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The default lanes, 16, 64 and 128: each a row whose figures are ordered
+/// as work and span must be (span ≤ work, speed-up ≤ lanes and ≤ the
+/// parallelism), ending in off's bits.
+fn work_and_span_rows(table: &str) {
+    let rows: Vec<Vec<&str>> = table
+        .lines()
+        .filter(|l| l.starts_with("| ") && !l.starts_with("| lanes"))
+        .map(|l| l.split('|').map(str::trim).collect())
+        .collect();
+    let lanes: Vec<&str> = rows.iter().map(|r| r[1]).collect();
+    assert_eq!(lanes, ["16", "64", "128"], "{table}");
+    let num = |c: &str| c.trim_end_matches('×').parse::<f64>().unwrap();
+    for r in &rows {
+        let (work, span, par, speedup) = (num(r[2]), num(r[4]), num(r[5]), num(r[6]));
+        assert!(work > 0.0 && span > 0.0 && span <= work + 1e-3, "{r:?}");
+        assert!(par >= 1.0 && speedup <= par + 0.05, "{r:?}");
+        assert!(speedup <= num(r[1]), "{r:?}");
+        assert_eq!(r[8], "yes", "same bits: {r:?}");
+    }
+}
+
+/// The CSV's `span` rows: lanes, work, span and parallelism filled in.
+fn work_and_span_csv(body: &[Vec<&str>], csv: &str) {
+    let spans: Vec<&Vec<&str>> = body.iter().filter(|r| r[0] == "span").collect();
+    assert_eq!(spans.len(), 3, "{csv}");
+    for r in spans {
+        let num = |i: usize| r[i].parse::<f64>().unwrap();
+        assert!(
+            num(14) > 0.0 && num(15) > 0.0 && num(15) <= num(14),
+            "{r:?}"
+        );
+        assert!(num(16) >= 1.0 && num(7) <= num(16) + 1e-9, "{r:?}");
+        assert_eq!(r[13], "true", "{r:?}");
+    }
 }
 
 /// The CSV's measured serial fraction and Karp–Flatt cells: empty or in
@@ -175,6 +223,19 @@ fn the_fit_lies_among_the_pools_fractions(table: &str, body: &[Vec<&str>]) {
 }
 
 #[test]
+fn lanes_out_of_range_are_refused_with_the_value_and_the_range() {
+    for bad in ["0", "100000", "x", "16,0"] {
+        let out = scaling(&["--lanes", bad]);
+        assert_eq!(out.status.code(), Some(2), "{bad}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        let first = err.lines().next().unwrap_or_default();
+        assert!(first.contains(&format!("'{bad}'")), "{bad}: {err}");
+        assert!(first.contains("from 1 to 1024"), "{bad}: {err}");
+        assert!(out.stdout.is_empty());
+    }
+}
+
+#[test]
 fn an_empty_scene_is_refused_with_the_range() {
     let out = scaling(&["--count", "0"]);
     assert_eq!(out.status.code(), Some(2));
@@ -202,7 +263,11 @@ fn one_sphere_is_said_to_have_nothing_to_share() {
         .skip(1)
         .map(|l| l.split(',').collect())
         .collect();
-    let measured: Vec<&Vec<&str>> = body.iter().filter(|r| r[0] != "predicted").collect();
+    let measured: Vec<&Vec<&str>> = body
+        .iter()
+        .filter(|r| r[0] != "predicted" && r[0] != "span")
+        .collect();
+    work_and_span_csv(&body, &csv);
     assert_eq!(measured.len(), configs(2).len(), "{csv}");
     fractions_within_0_and_1(&measured, &csv);
     std::fs::remove_dir_all(&dir).unwrap();
@@ -242,9 +307,12 @@ fn on_a_terminal_a_progress_bar_counts_the_runs() {
         "0.3",
         "--threads",
         "2",
+        "--lanes",
+        "16,64",
     ];
     let mut app = pty::start(&args, None);
-    let runs = 1 + 3 * configs(2).len();
+    // The probe, every configuration each round, and a run for each lanes.
+    let runs = 1 + 3 * configs(2).len() + 2;
     let shown = app.wait_for("the progress bar", 60.0, |s| {
         s.contains(&format!("/{runs} runs"))
     });

@@ -31,9 +31,8 @@ use super::conflicts::{Conflicts, Finished};
 use super::partition::{Batch, Partition, Slot};
 use super::stats::RoundStats;
 use crate::physics::broad::Grid;
-use crate::physics::exec::{Exec, PerBlock, Serial, lanes_of, next_blocks};
+use crate::physics::exec::{Exec, PerBlock, Serial, lanes_of};
 use crate::physics::sphere::Sphere;
-use std::sync::atomic::AtomicUsize;
 
 /// Fewer spheres with events than this run their clusters on one lane.
 const LANES_MIN_MEMBERS: usize = 512;
@@ -264,33 +263,30 @@ impl Rounds {
         let (runs, outs, todo) = (&self.runs, &self.outs, &self.batch.todo);
         let (order, pairs) = (&self.batch.order, &self.batch.pairs);
         let lanes = lanes_of(exec, blocks, order.len());
-        let next = AtomicUsize::new(0);
-        exec.for_lanes(lanes, &|lane| {
+        exec.for_blocks(lanes, blocks, &|lane, b| {
             let mut run = runs[lane].lock();
-            for b in next_blocks(&next, blocks) {
-                let mut out = outs[b].lock();
-                out.done.clear();
-                out.chunk.clear();
-                out.cross.clear();
-                let end = ((b + 1) * CLUSTER_BLOCK).min(todo.len());
-                // The chunk is new (the last went to `Finished`): room for
-                // about what its runs write at once, not grown by doubling.
-                let members: usize = todo[b * CLUSTER_BLOCK..end]
-                    .iter()
-                    .map(|t| (t.m1 - t.m0) as usize)
-                    .sum();
-                out.chunk.members.reserve_exact(members + members / 8);
-                out.chunk.turns.reserve_exact(2 * members);
-                for t in &todo[b * CLUSTER_BLOCK..end] {
-                    let members = &order[t.m0 as usize..t.m1 as usize];
-                    let cp = &pairs[t.p0 as usize..t.p1 as usize];
-                    run.run(sh, members, cp, absorb);
-                    let before = out.chunk.members.len();
-                    run.emit(&mut out.chunk);
-                    out.cross.extend_from_slice(&run.cross);
-                    let len = (out.chunk.members.len() - before) as u32;
-                    out.done.push((run.capped, len, run.work));
-                }
+            let mut out = outs[b].lock();
+            out.done.clear();
+            out.chunk.clear();
+            out.cross.clear();
+            let end = ((b + 1) * CLUSTER_BLOCK).min(todo.len());
+            // The chunk is new (the last went to `Finished`): room for
+            // about what its runs write at once, not grown by doubling.
+            let members: usize = todo[b * CLUSTER_BLOCK..end]
+                .iter()
+                .map(|t| (t.m1 - t.m0) as usize)
+                .sum();
+            out.chunk.members.reserve_exact(members + members / 8);
+            out.chunk.turns.reserve_exact(2 * members);
+            for t in &todo[b * CLUSTER_BLOCK..end] {
+                let members = &order[t.m0 as usize..t.m1 as usize];
+                let cp = &pairs[t.p0 as usize..t.p1 as usize];
+                run.run(sh, members, cp, absorb);
+                let before = out.chunk.members.len();
+                run.emit(&mut out.chunk);
+                out.cross.extend_from_slice(&run.cross);
+                let len = (out.chunk.members.len() - before) as u32;
+                out.done.push((run.capped, len, run.work));
             }
         });
     }
