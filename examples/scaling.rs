@@ -21,29 +21,11 @@
 //! (`exact`: collisions, crossings, walls, relists, stale; the others:
 //! sphere and wall contacts) and sphere collisions per CPU second (issue
 //! 31's table), each against 10k's.
-//! `exact [rounds] [max N] [renumber]` is the table of `exact` alone; with
-//! `renumber` the model sorts its spheres again as they drift (default:
-//! only at load).
-//! `exact-one N packing steps [dt] [renumber] [calendar|tree]` runs one size
-//! only (for callgrind); with `renumber` the model sorts its spheres again
-//! as they drift, with `calendar` it runs over the calendar queue, with
-//! `tree` over the binary tournament (default: the eight-way one).
-//! `exact-renumber N packing rounds [steps]`: one scene, two models, one
-//! relabelling its spheres in space as they drift (the default) and one
-//! keeping the load's order, run side by side on copies of the world in
-//! blocks of `steps` steps of 2 ms (default 20), timed in alternation:
-//! events per second of each, per round, as the spheres drift from where
-//! the load sorted them; and the relabelled model's rate without the time
-//! its relabelling took (what the order buys the loop if keeping it were
-//! free: an upper bound for storing spheres by place).
-//! `exact-queues N packing rounds [steps] [calendar] [noprefetch]`: one scene, the exact
-//! model over today's event queue (the eight-way tournament) and another
-//! (the binary tournament, or with `calendar` the calendar), on copies of the world
-//! in blocks of `steps` steps of 2 ms (default 20), timed in alternation:
-//! events per second of each, and each queue's heap bytes a sphere. The
-//! two must process the same events: the counts are compared at the end.
-//! With `noprefetch` neither prefetches (only the eight-way tree names a
-//! runner-up, so this compares the queues alone).
+//! `exact [rounds] [max N]` is the table of `exact` alone.
+//! `exact-one N packing steps [dt]` runs one size only (for callgrind).
+//! (`exact-renumber` and `exact-queues`, which compared `exact` with its
+//! spheres relabelled as they drift and over other event queues, went with
+//! those experiments: docs/perf-log.md, 2026-12-07.)
 //!
 //! With `sorted`, both worlds are sorted in space (by cell of the 10k
 //! scene's grid, z then y then x) before every block, outside the timing:
@@ -52,11 +34,10 @@
 //! comparisons read spheres by index).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap fails the run
 use ballpit::cpu::{current_tid, thread_cpu_seconds_of};
-use ballpit::physics::exact::{Calendar, EventDriven, EventQueue, EventStats, Exact, Tournament};
+use ballpit::physics::exact::{EventStats, Exact};
 use ballpit::physics::sphere::volume;
 use ballpit::physics::{Model, ModelKind, Serial, World};
 use ballpit::scene::{SceneSpec, build_world};
-use std::fmt::Write as _;
 use std::time::{Duration, Instant};
 
 const SMALL: usize = 10_000;
@@ -105,16 +86,6 @@ fn events(s: &EventStats) -> u64 {
 }
 
 fn exact_one(args: &[String]) {
-    if args.iter().any(|a| a == "calendar") {
-        exact_one_with(args, EventDriven::<Calendar>::default());
-    } else if args.iter().any(|a| a == "tree") {
-        exact_one_with(args, EventDriven::<Tournament>::default());
-    } else {
-        exact_one_with(args, Exact::default());
-    }
-}
-
-fn exact_one_with<Q: EventQueue + Send>(args: &[String], model: EventDriven<Q>) {
     let num = |k: usize| args.get(k).and_then(|a| a.parse::<f64>().ok());
     let (n, packing, steps) = (
         num(0).expect("N") as usize,
@@ -124,8 +95,7 @@ fn exact_one_with<Q: EventQueue + Send>(args: &[String], model: EventDriven<Q>) 
     let empty = status_kib("VmRSS");
     let mut world = exact_scene(n, packing);
     let (scene_peak, scene_rss) = (status_kib("VmHWM"), status_kib("VmRSS"));
-    let renumber = args.iter().any(|a| a == "renumber");
-    let mut model = model.with_renumbering(renumber);
+    let mut model = Exact::default();
     let start = Instant::now();
     model.advance(&mut world, 1e-9, 1, &Serial);
     let load = start.elapsed();
@@ -138,13 +108,9 @@ fn exact_one_with<Q: EventQueue + Send>(args: &[String], model: EventDriven<Q>) 
     let ev = events(&model.stats) - e0;
     let per = |kib: u64| (kib.saturating_sub(empty) * 1024) as f64 / n.max(1) as f64;
     println!(
-        "{n} spheres, packing {packing}, {}: load {:.3} s, model heap {} bytes a sphere; \
+        "{n} spheres, packing {packing}: load {:.3} s, model heap {} bytes a sphere; \
          RSS a sphere: {:.0} after the scene (peak {:.0}), {:.0} after the steps (peak {:.0}); \
          {ev} events, {:.3} M/s ({:?})",
-        std::any::type_name::<Q>()
-            .rsplit("::")
-            .next()
-            .unwrap_or("?"),
         load.as_secs_f64(),
         model.heap_bytes() / n.max(1),
         per(scene_rss),
@@ -153,163 +119,6 @@ fn exact_one_with<Q: EventQueue + Send>(args: &[String], model: EventDriven<Q>) 
         per(status_kib("VmHWM")),
         ev as f64 / secs / 1e6,
         model.stats
-    );
-}
-
-/// `N packing rounds [steps]` of the side-by-side runs (20 steps a block
-/// by default).
-fn side_by_side_args(args: &[String]) -> (usize, f64, usize, u64) {
-    let num = |k: usize| args.get(k).and_then(|a| a.parse::<f64>().ok());
-    (
-        num(0).expect("N") as usize,
-        num(1).expect("packing"),
-        num(2).expect("rounds") as usize,
-        num(3).map_or(20, |s| s as u64),
-    )
-}
-
-fn exact_renumber(args: &[String]) {
-    let (n, packing, rounds, steps) = side_by_side_args(args);
-    let world = exact_scene(n, packing);
-    let mut runs = [
-        (
-            "renumbered",
-            world.clone(),
-            Exact::default().with_renumbering(true),
-        ),
-        ("load order", world, Exact::default()),
-    ];
-    for (_, w, m) in &mut runs {
-        m.advance(w, 1e-9, 1, &Serial);
-    }
-    let e0 = events(&runs[0].2.stats);
-    // Seconds with the relabelling, and without it: the second is what the
-    // order buys the loop, had keeping it been free (an upper bound).
-    let (mut total, mut spent, mut sorting) = ([0u64; 2], [0f64; 2], 0.0);
-    for round in 0..rounds {
-        let mut line = format!("round {round}:");
-        for (k, (name, w, m)) in runs.iter_mut().enumerate() {
-            // Untimed: the caches after the other model.
-            m.advance(w, DT_EXACT, 1, &Serial);
-            let (before, sorted_before) = (events(&m.stats), m.stats.renumber_nanos);
-            let start = Instant::now();
-            m.advance(w, DT_EXACT, steps, &Serial);
-            let secs = start.elapsed().as_secs_f64();
-            let ev = events(&m.stats) - before;
-            total[k] += ev;
-            spent[k] += secs;
-            sorting += (m.stats.renumber_nanos - sorted_before) as f64 * 1e-9;
-            let _ = write!(
-                line,
-                " {name} {:.3} M events/s ({} renumberings, {:.1} crossings+relists a sphere);",
-                ev as f64 / secs / 1e6,
-                m.stats.renumberings,
-                (m.stats.crossings + m.stats.relists) as f64 / n as f64
-            );
-        }
-        let rate = |k: usize| total[k] as f64 / spent[k];
-        let free = total[0] as f64 / (spent[0] - sorting);
-        println!(
-            "{line} so far renumbered/load order {:.2}, without the relabelling's time {:.2}",
-            rate(0) / rate(1),
-            free / rate(1)
-        );
-    }
-    println!(
-        "{n} spheres, packing {packing}: {} events a model; renumbered {:.3} M/s \
-         ({:.3} M/s without the relabelling's {:.2} s), load order {:.3} M/s",
-        events(&runs[0].2.stats) - e0,
-        total[0] as f64 / spent[0] / 1e6,
-        total[0] as f64 / (spent[0] - sorting) / 1e6,
-        sorting,
-        total[1] as f64 / spent[1] / 1e6
-    );
-}
-
-/// One untimed step (the caches after the other model), then `steps` timed:
-/// the events processed and the seconds.
-fn timed_block<Q: EventQueue + Send>(
-    m: &mut EventDriven<Q>,
-    w: &mut World,
-    steps: u64,
-) -> (u64, f64) {
-    m.advance(w, DT_EXACT, 1, &Serial);
-    let before = events(&m.stats);
-    let start = Instant::now();
-    m.advance(w, DT_EXACT, steps, &Serial);
-    (events(&m.stats) - before, start.elapsed().as_secs_f64())
-}
-
-fn exact_queues(args: &[String]) {
-    if args.iter().any(|a| a == "calendar") {
-        exact_queues_with::<Calendar>(args, "calendar");
-    } else {
-        exact_queues_with::<Tournament>(args, "binary tree");
-    }
-}
-
-/// Today's queue (the eight-way tree) against queue `Q`.
-fn exact_queues_with<Q: EventQueue + Send>(args: &[String], name: &str) {
-    let (n, packing, rounds, steps) = side_by_side_args(args);
-    let world = exact_scene(n, packing);
-    let (mut wt, mut wc) = (world.clone(), world);
-    // Only the eight-way tree names a runner-up to prefetch for: with
-    // `noprefetch` neither model prefetches, and the queues are compared
-    // on equal terms.
-    let (mut tree, mut other) = (Exact::default(), EventDriven::<Q>::default());
-    if args.iter().any(|a| a == "noprefetch") {
-        tree = tree.with_prefetching(false);
-        other = other.with_prefetching(false);
-    }
-    tree.advance(&mut wt, 1e-9, 1, &Serial);
-    other.advance(&mut wc, 1e-9, 1, &Serial);
-    let (mut total, mut spent) = ([0u64; 2], [0f64; 2]);
-    for round in 0..rounds {
-        // Which goes first alternates too.
-        let order = if round % 2 == 0 { [0, 1] } else { [1, 0] };
-        let mut rates = [0.0; 2];
-        for k in order {
-            let (ev, secs) = if k == 0 {
-                timed_block(&mut tree, &mut wt, steps)
-            } else {
-                timed_block(&mut other, &mut wc, steps)
-            };
-            total[k] += ev;
-            spent[k] += secs;
-            rates[k] = ev as f64 / secs / 1e6;
-        }
-        let rate = |k: usize| total[k] as f64 / spent[k];
-        println!(
-            "round {round}: eight-way {:.3} M events/s, {name} {:.3} M events/s; \
-             so far {name}/eight-way {:.3}",
-            rates[0],
-            rates[1],
-            rate(1) / rate(0)
-        );
-    }
-    assert_eq!(
-        tree.stats, other.stats,
-        "the two queues processed different events"
-    );
-    assert!(
-        wt.spheres
-            .iter()
-            .zip(&wc.spheres)
-            .all(|(a, b)| a.pos == b.pos && a.vel == b.vel),
-        "the two queues left different worlds"
-    );
-    println!(
-        "exact-queues N {n} packing {packing}: {} events a model; eight-way {:.3} M/s, \
-         {name} {:.3} M/s, {name}/eight-way {:.3}; queue heap bytes a sphere: \
-         eight-way {:.1}, {name} {:.1}; model heap bytes a sphere: eight-way {:.0}, {name} {:.0}",
-        total[0],
-        total[0] as f64 / spent[0] / 1e6,
-        total[1] as f64 / spent[1] / 1e6,
-        (total[1] as f64 / spent[1]) / (total[0] as f64 / spent[0]),
-        tree.queue_heap_bytes() as f64 / n as f64,
-        other.queue_heap_bytes() as f64 / n as f64,
-        tree.heap_bytes() as f64 / n as f64,
-        other.heap_bytes() as f64 / n as f64,
     );
 }
 
@@ -331,9 +140,9 @@ enum Held {
 }
 
 impl Held {
-    fn new(kind: ModelKind, renumber: bool) -> Held {
+    fn new(kind: ModelKind) -> Held {
         match kind {
-            ModelKind::Exact => Held::Exact(Box::new(Exact::default().with_renumbering(renumber))),
+            ModelKind::Exact => Held::Exact(Box::default()),
             other => Held::Other(other.build()),
         }
     }
@@ -377,13 +186,12 @@ struct Run {
     collisions: u64,
 }
 
-/// `table [rounds] [max N] [model ...] [renumber]` (and `exact ...`, the
+/// `table [rounds] [max N] [model ...]` (and `exact ...`, the
 /// same for `exact` alone): per model and packing, the sizes 10k, 100k
 /// and 1M timed in alternation.
 fn table(args: &[String], default_models: &[ModelKind]) {
     let rounds: usize = args.first().map_or(5, |r| r.parse().expect("rounds"));
     let max: usize = args.get(1).map_or(1_000_000, |m| m.parse().expect("max N"));
-    let renumber = args.iter().any(|a| a == "renumber");
     let mut models: Vec<ModelKind> = args.iter().filter_map(|a| a.parse().ok()).collect();
     if models.is_empty() {
         models = default_models.to_vec();
@@ -400,24 +208,18 @@ fn table(args: &[String], default_models: &[ModelKind]) {
             _ => (DT, 200_000, &[0.005, 0.1]),
         };
         for &packing in packings {
-            let runs = build_runs(kind, &sizes, packing, work, renumber);
+            let runs = build_runs(kind, &sizes, packing, work);
             time_runs(runs, rounds, dt, kind, packing);
         }
     }
 }
 
-fn build_runs(
-    kind: ModelKind,
-    sizes: &[usize],
-    packing: f64,
-    work: u64,
-    renumber: bool,
-) -> Vec<Run> {
+fn build_runs(kind: ModelKind, sizes: &[usize], packing: f64, work: u64) -> Vec<Run> {
     let mut runs = Vec::new();
     for &n in sizes {
         let peak = peak_bytes(kind, n, packing);
         let mut world = exact_scene(n, packing);
-        let mut model = Held::new(kind, renumber);
+        let mut model = Held::new(kind);
         let start = Instant::now();
         model.model().advance(&mut world, 1e-9, 1, &Serial);
         let load = start.elapsed().as_secs_f64();
@@ -472,7 +274,7 @@ fn peak(args: &[String]) {
     let packing: f64 = args[2].parse().expect("packing");
     let before = status_kib("VmHWM:");
     let mut world = exact_scene(n, packing);
-    let mut model = Held::new(kind, false);
+    let mut model = Held::new(kind);
     let dt = if kind == ModelKind::Exact {
         DT_EXACT
     } else {
@@ -540,8 +342,6 @@ fn main() {
         Some("table") => return table(&args[1..], &ModelKind::ALL),
         Some("peak") => return peak(&args[1..]),
         Some("exact-one") => return exact_one(&args[1..]),
-        Some("exact-renumber") => return exact_renumber(&args[1..]),
-        Some("exact-queues") => return exact_queues(&args[1..]),
         _ => {}
     }
     let sorted = args.iter().any(|a| a == "sorted");

@@ -7,9 +7,9 @@ use super::cell_grid::CellGrid;
 use super::ids::Label;
 use super::queue::EventQueue;
 use super::schedule::{Event, Kind, Queued};
-use super::{Broad, EventDriven};
+use super::{Broad, Exact};
 
-impl<Q: EventQueue> EventDriven<Q> {
+impl Exact {
     /// Start loading what the loop will read next: the cells a crossing
     /// of `i` (event `ev`) reads and its pending partner's body; after a
     /// contact or a wall, what predicting `i` reads first, and the

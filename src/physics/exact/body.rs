@@ -124,12 +124,6 @@ impl Bodies {
         }
     }
 
-    /// The bodies, to be put in a new order.
-    #[cfg(feature = "experiments")]
-    pub fn list_mut(&mut self) -> &mut Vec<Body> {
-        &mut self.list
-    }
-
     /// Bytes held on the heap.
     pub fn heap_bytes(&self) -> usize {
         self.list.capacity() * size_of::<Body>() + self.species.heap_bytes()

@@ -1,5 +1,5 @@
-//! An eight-way tournament ([`EightWay`]): the binary tournament
-//! (`tournament.rs`) with eight children a node, so a node's children are
+//! An eight-way tournament ([`EightWay`]): the binary tournament it
+//! replaced (deleted 2026-12-07, docs/perf-log.md) with eight children a node, so a node's children are
 //! one cache line of keys. An update climbs log8 N levels instead of
 //! log2 N: 7 lines at a million spheres where the binary tree touched 20
 //! (the lower ones missed the cache at that size), and the inner nodes take

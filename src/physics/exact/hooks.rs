@@ -1,11 +1,11 @@
-//! The knobs tests, benchmarks and examples turn (feature `experiments`,
-//! which the crate's dev-dependency on itself enables; the shipped binary
-//! has none): a smaller event cap, a finer cell grid, renumbering as the
-//! spheres drift ([`super::renumber`]), prefetching at any count or none,
-//! and an observer of every contact.
-use super::ids::Label;
-use super::queue::EventQueue;
-use super::{EventDriven, cell_grid};
+//! The one seam between the model and what tests, benchmarks and examples
+//! turn: a smaller event cap, a finer cell grid, prefetching at any count
+//! or none, and an observer of every contact. The model asks [`Hooks`] for
+//! each; built without the feature `experiments` (which the crate's
+//! dev-dependency on itself enables; the shipped binary has none), `Hooks`
+//! holds nothing and answers the defaults, and the observer's contact is
+//! never made.
+use super::ids::{Label, WorldId};
 use crate::physics::sphere::Sphere;
 use glam::DVec3;
 
@@ -26,33 +26,100 @@ pub struct Contact {
 
 pub type Observer = Box<dyn FnMut(&Contact) + Send>;
 
+/// The contact of labels `i` and `j` at absolute `time`, now `a` and `b`
+/// after it, their velocities `before` it; `order` maps labels to world ids.
+pub(super) fn contact(
+    order: &[WorldId],
+    time: f64,
+    (i, j): (Label, Label),
+    [a, b]: [&Sphere; 2],
+    before: [DVec3; 2],
+) -> Contact {
+    // Lower world id first, whichever of the two predicted the contact
+    // (labels decide that on a tie; `resolve_pair` gives the same
+    // velocities either way round, bit for bit), so observers see the
+    // same contact whatever the labels.
+    let ids = [order[i.index()], order[j.index()]];
+    let lo = usize::from(ids[1] < ids[0]);
+    let spheres = [a, b];
+    let (p, q) = (spheres[lo], spheres[1 - lo]);
+    Contact {
+        time,
+        i: ids[lo].index(),
+        j: ids[1 - lo].index(),
+        pos_i: p.pos,
+        pos_j: q.pos,
+        impulse: p.mass * (p.vel - before[lo]).length(),
+    }
+}
+
 /// What the knobs are set to; the defaults are the shipped model's.
+#[cfg(feature = "experiments")]
 #[derive(Default)]
 pub(super) struct Hooks {
     cap: Option<u64>,
     cells_per_sphere: Option<u32>,
-    /// Sort the spheres in space again as they drift (off by default: it
-    /// measured slower, see docs/benchmarks.md "exact at scale").
-    pub renumbering: bool,
-    /// Prefetch whatever the count (`Some(true)`) or never (`Some(false)`);
-    /// by default from [`super::PREFETCH_FROM`] spheres.
-    pub prefetching: Option<bool>,
-    /// Broad-phase events (crossings, relists) at the last spatial sort.
-    pub sorted_at: u64,
+    /// Prefetch whatever the count (`Some(true)`) or never (`Some(false)`).
+    prefetching: Option<bool>,
     observer: Option<Observer>,
 }
 
+/// Nothing to turn: the defaults.
+#[cfg(not(feature = "experiments"))]
+#[derive(Default)]
+pub(super) struct Hooks;
+
+#[cfg(feature = "experiments")]
 impl Hooks {
-    pub fn cap(&self) -> Option<u64> {
-        self.cap
+    /// The events a step may take, `default` unless set.
+    pub fn event_cap(&self, default: u64) -> u64 {
+        self.cap.unwrap_or(default)
     }
 
+    /// The most cells per sphere of the cell grid.
     pub fn cells_per_sphere(&self) -> u32 {
-        self.cells_per_sphere.unwrap_or(cell_grid::CELLS_PER_SPHERE)
+        self.cells_per_sphere
+            .unwrap_or(super::cell_grid::CELLS_PER_SPHERE)
+    }
+
+    /// Whether the loop prefetches, `default` unless set.
+    pub fn prefetching(&self, default: bool) -> bool {
+        self.prefetching.unwrap_or(default)
+    }
+
+    /// Tell the observer, if any, of a contact (made only then).
+    pub fn observe(&mut self, contact: impl FnOnce() -> Contact) {
+        if let Some(f) = &mut self.observer {
+            f(&contact());
+        }
     }
 }
 
-impl<Q: EventQueue> EventDriven<Q> {
+// The same answers as the knobs' defaults, for the model to ask either way.
+#[cfg(not(feature = "experiments"))]
+#[expect(clippy::unused_self, reason = "the knobs' signatures, with none set")]
+impl Hooks {
+    #[inline(always)]
+    pub fn event_cap(&self, default: u64) -> u64 {
+        default
+    }
+
+    #[inline(always)]
+    pub fn cells_per_sphere(&self) -> u32 {
+        super::cell_grid::CELLS_PER_SPHERE
+    }
+
+    #[inline(always)]
+    pub fn prefetching(&self, default: bool) -> bool {
+        default
+    }
+
+    #[inline(always)]
+    pub fn observe(&mut self, _contact: impl FnOnce() -> Contact) {}
+}
+
+#[cfg(feature = "experiments")]
+impl super::Exact {
     /// Set the events a step may take (default: [`super::EVENT_CAP_BASE`]
     /// plus [`super::EVENT_CAP_PER_SPHERE`] per sphere).
     #[must_use]
@@ -62,23 +129,16 @@ impl<Q: EventQueue> EventDriven<Q> {
     }
 
     /// Set the most cells per sphere of the cell grid (default
-    /// [`cell_grid::CELLS_PER_SPHERE`]; at least 1), for comparing grids.
+    /// [`super::cell_grid::CELLS_PER_SPHERE`]; at least 1), for comparing grids.
     #[must_use]
     pub fn with_cells_per_sphere(mut self, k: u32) -> Self {
         self.hooks.cells_per_sphere = Some(k.max(1));
         self
     }
 
-    /// Sort the spheres by cell again as they drift (default: only at
-    /// load), for comparing the two.
-    #[must_use]
-    pub fn with_renumbering(mut self, on: bool) -> Self {
-        self.hooks.renumbering = on;
-        self
-    }
-
-    /// Prefetch at any count (`true`) or never (`false`), for holding the
-    /// two to the same runs and comparing their speed.
+    /// Prefetch at any count (`true`) or never (`false`; by default from
+    /// [`super::PREFETCH_FROM`] spheres), for holding the two to the same
+    /// runs and comparing their speed.
     #[must_use]
     pub fn with_prefetching(mut self, on: bool) -> Self {
         self.hooks.prefetching = Some(on);
@@ -88,34 +148,5 @@ impl<Q: EventQueue> EventDriven<Q> {
     /// Call `f` for every sphere–sphere contact.
     pub fn set_observer(&mut self, f: Option<Observer>) {
         self.hooks.observer = f;
-    }
-
-    /// Tell the observer, if any, of the contact of `i` and `j`, now `a`
-    /// and `b` after it, their velocities `before` it.
-    pub(super) fn observe(
-        &mut self,
-        (i, j): (Label, Label),
-        [a, b]: [&Sphere; 2],
-        before: [DVec3; 2],
-    ) {
-        let Some(f) = &mut self.hooks.observer else {
-            return;
-        };
-        // Lower world id first, whichever of the two predicted the contact
-        // (labels decide that on a tie; `resolve_pair` gives the same
-        // velocities either way round, bit for bit), so observers see the
-        // same contact whatever the labels.
-        let ids = [self.order[i.index()], self.order[j.index()]];
-        let lo = usize::from(ids[1] < ids[0]);
-        let spheres = [a, b];
-        let (p, q) = (spheres[lo], spheres[1 - lo]);
-        f(&Contact {
-            time: self.origin + self.bodies[i].t,
-            i: ids[lo].index(),
-            j: ids[1 - lo].index(),
-            pos_i: p.pos,
-            pos_j: q.pos,
-            impulse: p.mass * (p.vel - before[lo]).length(),
-        });
     }
 }

@@ -46,8 +46,8 @@ macro_rules! index_type {
 }
 
 index_type!(
-    /// A body's place in the model's own order (sorted in space at load,
-    /// and again as the spheres drift if renumbering is on): never a world id.
+    /// A body's place in the model's own order (sorted in space at load):
+    /// never a world id.
     Label, packed
 );
 

@@ -6,9 +6,7 @@
 //!   moved only when an event touches it or when `advance` returns;
 //! - one pending event per sphere (the earliest of contact, wall, or its
 //!   broad-phase event), in an [`EventQueue`] (a tournament tree of eight
-//!   children a node, [`EightWay`]; the binary tree and the bucket queue
-//!   `calendar` it was measured against are experiments, feature
-//!   `experiments`);
+//!   children a node, [`EightWay`]);
 //! - a broad phase chosen by packing fraction ([`LISTS_ABOVE_PACKING`]):
 //!   a cell grid with cell-crossing events for dilute and moderate scenes
 //!   ([`cell_grid`]), neighbour lists with a skin for dense ones
@@ -20,18 +18,17 @@
 //!   contact partner's records, the candidates' bodies, and the records of
 //!   the queue's runner-up (the next event's sphere nearly always), so their
 //!   cache misses overlap instead of following one another;
-//! - spheres sorted in space at load (`spatial`; relabelling them again
-//!   as they drift, `renumber`, is an experiment); the world keeps every
+//! - spheres sorted in space at load (`spatial`); the world keeps every
 //!   sphere at its id (`ids`: labels and world ids are apart).
 //!
 //! Time of impact comes from [`pair_toi`](crate::physics::contact::pair_toi)
 //! (stable quadratic, rounding guard: overlapping and approaching collides
 //! now, receding is left alone). Simultaneous events are processed in a
 //! fixed order: by the sphere whose prediction it is, in the model's
-//! internal order (sorted in space at load, and, if asked, again as the
-//! spheres drift, `renumber`: a pure function of the world and its history; a contact
-//! taken by either of its spheres is the same contact, bit for bit, and is
-//! reported lower world id first); a sphere's own candidates tie its broad-phase
+//! internal order (sorted in space at load: a pure function of the world
+//! and its history; a contact taken by either of its spheres is the same
+//! contact, bit for bit, and is reported lower world id first); a sphere's
+//! own candidates tie its broad-phase
 //! event (relist or crossing) first, then walls, then partners in the order
 //! the broad phase offers them.
 //! Runs are therefore reproducible, and the event loop runs on one thread
@@ -51,25 +48,18 @@
 //! the schedule is rebuilt for the next step.
 mod ahead;
 pub mod body;
-#[cfg(feature = "experiments")]
-mod calendar;
 pub mod cell_grid;
 mod eight_way;
-#[cfg(feature = "experiments")]
 mod hooks;
 mod ids;
 mod large;
 mod neighbour_lists;
 mod overlap;
 mod queue;
-#[cfg(feature = "experiments")]
-mod renumber;
 pub mod schedule;
 mod spatial;
 mod species;
 mod sync;
-#[cfg(feature = "experiments")]
-mod tournament;
 
 use super::contact::{reflect_walls, resolve_pair};
 use super::exec::Exec;
@@ -79,18 +69,13 @@ use super::sphere::Sphere;
 use super::world::{Counters, World};
 use ahead::prefetch_next_crossing;
 use body::Bodies;
-#[cfg(feature = "experiments")]
-pub use calendar::Calendar;
 use cell_grid::CellGrid;
 pub use eight_way::EightWay;
-#[cfg(feature = "experiments")]
 pub use hooks::{Contact, Observer};
 use ids::{Label, WorldId};
 use neighbour_lists::NeighbourLists;
 pub use queue::EventQueue;
 use schedule::{Event, Kind, Predictor, Queued, Slot};
-#[cfg(feature = "experiments")]
-pub use tournament::Tournament;
 
 /// Events (contacts, wall hits, relists, stale predictions) a step may take,
 /// at least; scenes add [`EVENT_CAP_PER_SPHERE`] per sphere.
@@ -130,17 +115,12 @@ impl Default for Broad {
     }
 }
 
-/// The model, with today's event queue: the eight-way tournament, faster
-/// than the binary one from 4k to 1M spheres and level at 4k dense; the
-/// calendar measured slower but at 1M dilute (docs/benchmarks.md,
-/// "exact's event queue", and the 2026-12-05 entry of docs/perf-log.md).
-pub type Exact = EventDriven<EightWay>;
-
-/// The model over an event queue `Q` ([`EightWay`], or the experiments'
-/// `Tournament` and `Calendar`; a type parameter, so all run in one binary
-/// at no cost to any).
+/// The model. Its event queue is the eight-way tournament, faster than the
+/// binary one from 4k to 1M spheres and level at 4k dense; a calendar
+/// measured slower but at 1M dilute (docs/perf-log.md, 2026-12-05 and
+/// 2026-12-07).
 #[derive(Default)]
-pub struct EventDriven<Q: EventQueue> {
+pub struct Exact {
     bodies: Bodies,
     /// World index of each body: bodies are kept in a spatial order (sorted
     /// by cell when loaded), so neighbours sit close in memory and a
@@ -157,7 +137,7 @@ pub struct EventDriven<Q: EventQueue> {
     /// With neighbour lists: each sphere's event, whose time the queue
     /// alone keeps (8 bytes a sphere less than a slot). Empty in cell mode.
     events: Vec<Event>,
-    queue: Q,
+    queue: EightWay,
     broad: Broad,
     /// Scratch for the candidates a prediction gathers: labels, as the
     /// cell grid packs them ([`Label::raw`]).
@@ -172,7 +152,7 @@ pub struct EventDriven<Q: EventQueue> {
     valid: bool,
     /// Whether the loop prefetches ([`PREFETCH_FROM`]).
     prefetching: bool,
-    #[cfg(feature = "experiments")]
+    /// What tests and examples turn ([`hooks`]).
     hooks: hooks::Hooks,
     /// Events processed since construction, by kind.
     pub stats: EventStats,
@@ -189,16 +169,9 @@ pub struct EventStats {
     pub crossings: u64,
     /// Full rebuilds of the schedule (start, outside changes, capped steps).
     pub rebuilds: u64,
-    /// Spatial re-sorts of the spheres (`renumber`, feature `experiments`).
-    #[cfg(feature = "experiments")]
-    pub renumberings: u64,
-    /// Time those re-sorts took, in nanoseconds: a benchmark can then tell
-    /// what the order buys the loop from what keeping it costs.
-    #[cfg(feature = "experiments")]
-    pub renumber_nanos: u64,
 }
 
-impl<Q: EventQueue> EventDriven<Q> {
+impl Exact {
     /// Bytes the model holds on the heap (its copy of the spheres, the
     /// schedule and the broad phase; not the world's own spheres).
     pub fn heap_bytes(&self) -> usize {
@@ -222,21 +195,8 @@ impl<Q: EventQueue> EventDriven<Q> {
     }
 
     fn event_cap(&self) -> u64 {
-        #[cfg(feature = "experiments")]
-        if let Some(cap) = self.hooks.cap() {
-            return cap;
-        }
-        EVENT_CAP_BASE + EVENT_CAP_PER_SPHERE * self.bodies.len() as u64
-    }
-
-    /// The most cells per sphere of the cell grid.
-    // Without the experiments' knobs, the default alone.
-    #[cfg_attr(not(feature = "experiments"), expect(clippy::unused_self))]
-    fn cells_per_sphere(&self) -> u32 {
-        #[cfg(feature = "experiments")]
-        return self.hooks.cells_per_sphere();
-        #[cfg(not(feature = "experiments"))]
-        cell_grid::CELLS_PER_SPHERE
+        let cap = EVENT_CAP_BASE + EVENT_CAP_PER_SPHERE * self.bodies.len() as u64;
+        self.hooks.event_cap(cap)
     }
 
     /// New neighbour lists and a prediction for every sphere, at the bodies'
@@ -264,14 +224,10 @@ impl<Q: EventQueue> EventDriven<Q> {
             self.slots = super::huge_pages::filled(n, Slot::default());
             self.holds = super::huge_pages::filled(n, Queued::PENDING);
             let mut cells = Box::<CellGrid>::default();
-            cells.build(&self.bodies, self.size, self.cells_per_sphere());
+            cells.build(&self.bodies, self.size, self.hooks.cells_per_sphere());
             self.broad = Broad::Cells(cells);
         }
-        self.prefetching = n >= PREFETCH_FROM;
-        #[cfg(feature = "experiments")]
-        if let Some(on) = self.hooks.prefetching {
-            self.prefetching = on;
-        }
+        self.prefetching = self.hooks.prefetching(n >= PREFETCH_FROM);
         self.queue.reset(n);
         for i in self.bodies.labels() {
             let t = if self.prefetching {
@@ -468,12 +424,14 @@ impl<Q: EventQueue> EventDriven<Q> {
     fn collide(&mut self, i: Label, j: Label, c: &mut Counters) {
         let mut a = self.bodies.sphere(i);
         let mut b = self.bodies.sphere(j);
-        #[cfg(feature = "experiments")]
         let before = [a.vel, b.vel];
         if resolve_pair(&mut a, &mut b) {
             c.sphere_collisions += 1;
-            #[cfg(feature = "experiments")]
-            self.observe((i, j), [&a, &b], before);
+            // The contact is made only for an observer (none when shipped).
+            self.hooks.observe(|| {
+                let time = self.origin + self.bodies[i].t;
+                hooks::contact(&self.order, time, (i, j), [&a, &b], before)
+            });
         }
         for (k, v) in [(i, a.vel), (j, b.vel)] {
             let body = &mut self.bodies[k];
@@ -495,7 +453,7 @@ impl<Q: EventQueue> EventDriven<Q> {
     }
 }
 
-impl<Q: EventQueue + Send> Model for EventDriven<Q> {
+impl Model for Exact {
     fn kind(&self) -> ModelKind {
         ModelKind::Exact
     }
@@ -513,8 +471,6 @@ impl<Q: EventQueue + Send> Model for EventDriven<Q> {
                 self.reorigin(world.time);
             }
             let target = end - self.origin;
-            #[cfg(feature = "experiments")]
-            self.renumber_if_drifted();
             if !self.valid {
                 for b in self.bodies.iter_mut() {
                     b.advance(world.time - self.origin);

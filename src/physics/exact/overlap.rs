@@ -10,8 +10,7 @@
 //! centre, so two spheres that touch are listed.
 use super::body::Bodies;
 use super::ids::Label;
-use super::queue::EventQueue;
-use super::{Broad, EventDriven};
+use super::{Broad, Exact};
 use crate::physics::exec::{Exec, for_each_block};
 use crate::physics::sphere::overlap_rel;
 use parking_lot::Mutex;
@@ -21,7 +20,7 @@ use parking_lot::Mutex;
 const BLOCK: usize = 1 << 12;
 const CELL_BLOCK: usize = 1 << 14;
 
-impl<Q: EventQueue> EventDriven<Q> {
+impl Exact {
     /// The deepest overlap between the bodies divided by the smaller radius
     /// (0 if none), as `World::max_overlap_rel` gives it for the world the
     /// bodies were last written to (the max is order-free, so the same bits).

@@ -1,9 +1,9 @@
 //! The event queue: one pending event per sphere ([`EventQueue`]), and the
 //! keys its trees compare. The queue the model runs on is
 //! [`super::eight_way::EightWay`], a tournament tree of eight children a
-//! node; the binary tournament (`tournament`) and the bucket queue
-//! (`calendar`) it was measured against are experiments (feature
-//! `experiments`), held to its order by `tests/physics/exact_queue.rs`.
+//! node, held to the order below by `tests/physics/exact_queue.rs` (the
+//! binary tournament and the bucket queue it was measured against are
+//! deleted: docs/perf-log.md, 2026-12-07).
 //! `DynamO` and Smallenburg's EDMD also keep one event per particle; a tree
 //! makes "replace sphere i's event" and "peek the earliest" O(log N) and
 //! O(1) with no allocation and no stale entries, which a binary heap of all

@@ -94,13 +94,6 @@ impl Event {
     pub fn partner_count(self) -> u32 {
         self.partner_count
     }
-
-    /// The same event, its partner renamed.
-    #[cfg(feature = "experiments")]
-    #[must_use]
-    pub fn with_partner(self, partner: Label) -> Event {
-        Event::new(self.kind(), self.mask(), partner, self.partner_count)
-    }
 }
 
 /// Which event the queue holds for a sphere in cell mode: its pending

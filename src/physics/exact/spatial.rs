@@ -6,7 +6,7 @@
 use glam::DVec3;
 
 /// The spheres' numbers (`number(i)` of the `i`th position: world ids at
-/// load, labels at a renumbering) in the order of their cells on a grid of
+/// load) in the order of their cells on a grid of
 /// about one cell a sphere, z then y then x; ties keep their current order
 /// (a counting sort: linear, and stable). `perm[new] = old`.
 #[must_use]

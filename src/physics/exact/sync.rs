@@ -2,11 +2,10 @@
 //! checked against it before each step, and written back after.
 use super::body::Bodies;
 use super::ids::WorldId;
-use super::queue::EventQueue;
-use super::{EventDriven, schedule, spatial};
+use super::{Exact, schedule, spatial};
 use crate::physics::world::World;
 
-impl<Q: EventQueue> EventDriven<Q> {
+impl Exact {
     /// Whether `world` is the one we last wrote, untouched since: its
     /// generation (every edit from outside a model calls `World::touch`),
     /// time, size and count are those of our write-back. The edit signal
@@ -34,10 +33,6 @@ impl<Q: EventQueue> EventDriven<Q> {
         self.order = spatial::spatial_order(positions, world.size, WorldId::at);
         self.bodies =
             Bodies::from_spheres(self.order.iter().map(|&k| &world.spheres[k.index()]), 0.0);
-        #[cfg(feature = "experiments")]
-        {
-            self.hooks.sorted_at = self.stats.crossings + self.stats.relists;
-        }
         self.reschedule_all();
     }
 

@@ -209,33 +209,6 @@ impl CellBlocks {
         }
     }
 
-    /// The spheres are relabelled (`inv[old] = new`); every cell keeps its
-    /// order.
-    #[cfg(feature = "experiments")]
-    pub fn relabel(&mut self, inv: &[Label]) {
-        let new = |j: u32| inv[j as usize].raw();
-        for c in 0..self.slot.len() {
-            let s = self.slot[c];
-            if s & ONE != 0 {
-                self.slot[c] = ONE | new(s & !ONE);
-                continue;
-            }
-            if s == EMPTY {
-                continue;
-            }
-            let b = self.block_mut(c);
-            let inline = (b[BLOCK] as usize).min(BLOCK);
-            for j in &mut b[..inline] {
-                *j = new(*j);
-            }
-        }
-        for o in self.overflow.values_mut() {
-            for j in o {
-                *j = new(*j);
-            }
-        }
-    }
-
     /// Start loading cell `c`'s word.
     #[inline(always)]
     pub fn prefetch(&self, c: usize) {

@@ -16,8 +16,6 @@ mod blocks;
 use super::body::{Bodies, Body};
 use super::ids::Label;
 use super::large::{BIG_FACTOR, Split, split_big, time_to_leave};
-#[cfg(feature = "experiments")]
-use super::renumber::apply;
 use super::schedule::{Event, Kind};
 use crate::physics::huge_pages;
 use blocks::CellBlocks;
@@ -282,22 +280,6 @@ impl CellGrid {
         let p = &mut self.place[i.index()];
         *p = if mask & 4 != 0 { *p + one } else { *p - one };
         self.list.move_to(i, c, to);
-    }
-
-    /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
-    /// every cell keeps its order.
-    #[cfg(feature = "experiments")]
-    pub fn relabel(&mut self, perm: &[Label], inv: &[Label]) {
-        self.list.relabel(inv);
-        apply(&mut self.place, perm);
-        let mut bigs: Vec<(Label, DVec3)> = self
-            .bigs
-            .iter()
-            .zip(&self.scan_centre)
-            .map(|(&b, &c)| (inv[b.index()], c))
-            .collect();
-        bigs.sort_unstable_by_key(|b| b.0);
-        (self.bigs, self.scan_centre) = bigs.into_iter().unzip();
     }
 
     /// A large sphere rescans from where it is now.

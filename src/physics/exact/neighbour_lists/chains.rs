@@ -8,8 +8,6 @@
 //! A sphere's cell is not stored: its owner recomputes it from the list
 //! centre, which is where the sphere was put in.
 use crate::physics::exact::ids::{Cell, Label};
-#[cfg(feature = "experiments")]
-use crate::physics::exact::renumber::apply;
 use crate::physics::huge_pages;
 
 #[derive(Clone, Debug, Default)]
@@ -56,18 +54,6 @@ impl CellChains {
             at = n;
         }
         debug_assert!(false, "sphere {i:?} is not in cell {c:?}");
-    }
-
-    /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
-    /// every chain keeps its order.
-    #[cfg(feature = "experiments")]
-    pub fn relabel(&mut self, perm: &[Label], inv: &[Label]) {
-        for v in [&mut self.head, &mut self.next] {
-            for x in v.iter_mut().filter(|x| **x != Label::NONE) {
-                *x = inv[x.index()];
-            }
-        }
-        apply(&mut self.next, perm);
     }
 
     /// Sphere `i` from cell `from` to cell `to`, first there.

@@ -3,8 +3,6 @@
 //! (and the large spheres') out of line. What is in them, and when, is the
 //! owner's ([`NeighbourLists`](super::NeighbourLists)).
 use crate::physics::exact::ids::Label;
-#[cfg(feature = "experiments")]
-use crate::physics::exact::renumber::{apply, apply_chunks};
 use crate::physics::huge_pages;
 
 /// Links in a cache line: a list of this many or fewer, at a stride of
@@ -313,30 +311,6 @@ impl Lists {
             if let Some(last) = self.flat.get(at + self.stride.saturating_sub(1)) {
                 line(last);
             }
-        }
-    }
-
-    /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
-    /// every list keeps its order.
-    #[cfg(feature = "experiments")]
-    pub(super) fn relabel(&mut self, perm: &[Label], inv: &[Label]) {
-        let (base, n) = (self.base, self.len.len());
-        apply_chunks(
-            &mut self.flat[base..base + n * self.stride],
-            self.stride,
-            perm,
-        );
-        apply(&mut self.len, perm);
-        // Flat lists here, the ones out of line below (each once).
-        for i in (0..n).map(Label::at) {
-            if let Home::Flat(_) = self.home(i) {
-                for l in self.of_mut(i) {
-                    l.j = inv[l.j.index()];
-                }
-            }
-        }
-        for l in self.out.iter_mut().flatten() {
-            l.j = inv[l.j.index()];
         }
     }
 }

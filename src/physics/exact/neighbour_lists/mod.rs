@@ -20,8 +20,6 @@ mod lists;
 use super::body::{Bodies, Body};
 use super::ids::{Cell, Label, SpeciesId};
 use super::large::{BIG_FACTOR, Split, split_big, time_to_leave};
-#[cfg(feature = "experiments")]
-use super::renumber::apply;
 use crate::physics::huge_pages;
 use chains::CellChains;
 use glam::DVec3;
@@ -149,21 +147,6 @@ impl NeighbourLists {
         }
         self.centre[i.index()].pos = bodies[i].pos.to_array();
         self.scan(i, bodies, |j| j != i, Lists::link);
-    }
-
-    /// The spheres are relabelled (`perm[new] = old`, `inv` its inverse);
-    /// every list and cell keeps its order.
-    #[cfg(feature = "experiments")]
-    pub fn relabel(&mut self, perm: &[Label], inv: &[Label]) {
-        apply(&mut self.centre, perm);
-        if !self.species.is_empty() {
-            apply(&mut self.species, perm);
-        }
-        self.lists.relabel(perm, inv);
-        self.cells.relabel(perm, inv);
-        for b in &mut self.bigs {
-            *b = inv[b.index()];
-        }
     }
 
     #[inline]
