@@ -4,7 +4,7 @@ use super::{Settings, Threading, physics_threads};
 use crate::physics::auto::Choice;
 use crate::physics::broad::Grid;
 use crate::physics::discrete::pair_budget;
-use crate::physics::exec::{Busy, for_each_block_of, for_each_chunk};
+use crate::physics::exec::{Busy, for_each_block_of, for_each_chunk, work_ns};
 use crate::physics::sphere::overlap_rel;
 use crate::physics::world::escapes;
 use crate::physics::{Counters, Exec, ModelKind, World};
@@ -12,6 +12,8 @@ use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 
 /// Spheres per parallel block when copying them out.
 const VIEW_BLOCK: usize = 8192;
+/// Predicted nanoseconds a sphere's view and counters cost (docs/threading.md).
+const NS_PER_VIEW: usize = 4;
 
 /// What the screen needs of one sphere. Single precision: a screen is a few
 /// thousand pixels across, f32 resolves a millionth of the box (20 bytes a
@@ -167,12 +169,13 @@ impl Snapshot {
         };
         if views {
             self.spheres.resize(sp.len(), SphereView::default());
-            for_each_chunk(exec, &mut self.spheres, VIEW_BLOCK, &|b, c| {
+            for_each_chunk(exec, &mut self.spheres, VIEW_BLOCK, NS_PER_VIEW, &|b, c| {
                 scan(b, Some(c));
             });
         } else {
             self.spheres = Vec::new();
-            for_each_block_of(exec, sp.len().div_ceil(VIEW_BLOCK), sp.len(), &|b| {
+            let work = work_ns(sp.len(), NS_PER_VIEW);
+            for_each_block_of(exec, sp.len().div_ceil(VIEW_BLOCK), work, &|b| {
                 scan(b, None);
             });
         }

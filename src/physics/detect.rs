@@ -4,7 +4,7 @@
 //! the two run side by side; otherwise each is cut into blocks over the
 //! lanes (`pool`). Either way the results are the same bits.
 use super::broad::{Grid, Pair};
-use super::exec::{Exec, PerBlock, Serial, for_each_block_of};
+use super::exec::{Exec, PerBlock, Serial, for_each_block_of, work_ns};
 use super::sphere::Sphere;
 use glam::DVec3;
 use parking_lot::Mutex;
@@ -12,6 +12,10 @@ use parking_lot::Mutex;
 /// Spheres per parallel block; fixed so results never depend on the number
 /// of threads.
 pub(crate) const SPHERE_BLOCK: usize = 2048;
+/// Predicted nanoseconds of a sphere's straight flight over a step, and of
+/// its test against the walls (docs/threading.md).
+pub(crate) const NS_PER_FLIGHT: usize = 3;
+const NS_PER_WALL_TEST: usize = 1;
 
 /// Where detection leaves its answers, kept between steps to reuse memory.
 #[derive(Default)]
@@ -50,7 +54,7 @@ impl Detection {
         let slots = &self.walls;
         let limit = self.pair_limit.unwrap_or(usize::MAX);
         let find_walls = |exec: &dyn Exec| {
-            for_each_block_of(exec, blocks, n, &|b| {
+            for_each_block_of(exec, blocks, work_ns(n, NS_PER_WALL_TEST), &|b| {
                 let mut v = slots[b].lock();
                 v.clear();
                 let (start, end) = (b * SPHERE_BLOCK, ((b + 1) * SPHERE_BLOCK).min(n));

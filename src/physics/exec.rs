@@ -39,10 +39,11 @@ pub trait Exec: Sync {
     fn cores(&self) -> usize {
         usize::MAX
     }
-    /// Items of work a lane must have before another is woken; an executor
-    /// that only checks the cut (tests) may say 1 to get every lane.
-    fn min_work(&self) -> usize {
-        MIN_WORK_PER_LANE
+    /// Nanoseconds of predicted work a lane must have before another is
+    /// woken; an executor that only checks the cut (tests) may say 1 to get
+    /// every lane.
+    fn lane_cost(&self) -> usize {
+        LANE_COST_NS
     }
     /// Told the lanes each section gets and why (see `lanes_of`).
     fn note_lanes(&self, _lanes: usize, _bound: Bound) {}
@@ -63,11 +64,18 @@ pub trait Exec: Sync {
     }
 }
 
-/// Items of work (spheres, pairs, cluster members) a lane must have before
-/// waking it pays: a sleeping thread takes tens of microseconds to wake and
-/// a sphere's share of a section a few tens of nanoseconds
-/// (docs/threading.md has the measurements behind the figure).
-pub const MIN_WORK_PER_LANE: usize = 4096;
+/// The lane rule: a section gets one lane for every this many nanoseconds
+/// of its predicted work, since waking a lane and handing it blocks costs
+/// tens of microseconds of the caller's and the woken thread's time
+/// (docs/threading.md, "How many lanes a pool section gets").
+pub const LANE_COST_NS: usize = 40_000;
+
+/// The predicted work of a section: `items` at `ns_each` nanoseconds each
+/// (each site's cost per item is measured in docs/threading.md).
+#[must_use]
+pub const fn work_ns(items: usize, ns_each: usize) -> usize {
+    items.saturating_mul(ns_each)
+}
 
 /// What held a parallel section to the lanes it got.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -92,9 +100,9 @@ pub struct Busy {
     pub bound: Bound,
 }
 
-/// The lanes a section of `blocks` blocks and `work` items gets from an
-/// executor of `threads` threads on `cores` cores, a lane wanting
-/// `min_work` items: the least of the four limits, at least one, and which
+/// The lanes a section of `blocks` blocks and `work` nanoseconds gets from
+/// an executor of `threads` threads on `cores` cores, a lane costing
+/// `lane_cost` nanoseconds: the least of the four limits, at least one, and which
 /// limit it was (the first that binds, in the order threads, cores, work,
 /// blocks).
 #[must_use]
@@ -103,7 +111,7 @@ pub fn lanes_for(
     cores: usize,
     blocks: usize,
     work: usize,
-    min_work: usize,
+    lane_cost: usize,
 ) -> (usize, Bound) {
     // When every thread (or core) has a lane, nothing else held it back,
     // even if the work would allow no more (8 789 spheres on 2 threads is
@@ -111,7 +119,7 @@ pub fn lanes_for(
     let limits = [
         (threads, Bound::Threads),
         (cores, Bound::Cores),
-        (work / min_work.max(1), Bound::Work),
+        (work / lane_cost.max(1), Bound::Work),
         (blocks, Bound::Blocks),
     ];
     let least = limits.iter().map(|l| l.0).min().unwrap_or(1).max(1);
@@ -122,12 +130,22 @@ pub fn lanes_for(
     (least, bound)
 }
 
-/// The lanes `exec` gives a section of `blocks` blocks and `work` items.
+/// The lanes `exec` gives a section of `blocks` blocks and `work`
+/// nanoseconds of predicted work.
 #[must_use]
 pub fn lanes_of(exec: &dyn Exec, blocks: usize, work: usize) -> usize {
-    let (lanes, bound) = lanes_for(exec.lanes(), exec.cores(), blocks, work, exec.min_work());
+    let (lanes, bound) = lanes_for(exec.lanes(), exec.cores(), blocks, work, exec.lane_cost());
     exec.note_lanes(lanes, bound);
     lanes
+}
+
+/// `exec`, or the calling thread where the lane rule would give a section
+/// of `blocks` blocks and `work` nanoseconds one lane anyway: for a pass
+/// whose parallel form costs more than its serial one.
+#[must_use]
+pub fn or_serial(exec: &dyn Exec, blocks: usize, work: usize) -> &dyn Exec {
+    let (lanes, _) = lanes_for(exec.lanes(), exec.cores(), blocks, work, exec.lane_cost());
+    if lanes > 1 { exec } else { &Serial }
 }
 
 /// Everything on the calling thread.
@@ -148,14 +166,15 @@ impl Exec for Serial {
 }
 
 /// Run `f(block, chunk)` for `data` cut into chunks of `block` items, the
-/// chunks spread over lanes (one item of data is one item of work).
+/// chunks spread over lanes (an item costing `ns_each` nanoseconds).
 pub fn for_each_chunk<T: Send>(
     exec: &dyn Exec,
     data: &mut [T],
     block: usize,
+    ns_each: usize,
     f: &(dyn Fn(usize, &mut [T]) + Sync),
 ) {
-    let work = data.len();
+    let work = work_ns(data.len(), ns_each);
     let chunks: Vec<Mutex<&mut [T]>> = data.chunks_mut(block).map(Mutex::new).collect();
     for_each_block_of(exec, chunks.len(), work, &|b| f(b, &mut chunks[b].lock()));
 }
@@ -163,10 +182,10 @@ pub fn for_each_chunk<T: Send>(
 /// Run `f(block)` for every block in `0..blocks`, each block counted as
 /// enough work for a lane (see `for_each_block_of`).
 pub fn for_each_block(exec: &dyn Exec, blocks: usize, f: &(dyn Fn(usize) + Sync)) {
-    for_each_block_of(exec, blocks, blocks.saturating_mul(MIN_WORK_PER_LANE), f);
+    for_each_block_of(exec, blocks, blocks.saturating_mul(exec.lane_cost()), f);
 }
 
-/// Run `f(block)` for every block in `0..blocks` (`work` items in all),
+/// Run `f(block)` for every block in `0..blocks` (`work` nanoseconds in all),
 /// blocks spread over the lanes `lanes_for` gives. Lanes take the next block
 /// as they finish one, so uneven blocks even out; each block's result is its
 /// own, so who ran it never shows.
@@ -236,16 +255,16 @@ pub fn spans<T>(data: &mut [T], lens: impl Iterator<Item = usize>) -> Vec<Mutex<
 
 #[cfg(test)]
 mod tests {
-    use super::{Bound, MIN_WORK_PER_LANE, PerBlock, lanes_for, spans};
+    use super::{Bound, LANE_COST_NS, PerBlock, Serial, lanes_for, or_serial, spans, work_ns};
 
     #[test]
     fn lanes_follow_the_tightest_limit() {
-        let w = MIN_WORK_PER_LANE;
+        let w = LANE_COST_NS;
         // An executor that wants every lane (tests of the cut) gets them.
         assert_eq!(lanes_for(8, 8, 100, 10, 1), (8, Bound::Threads));
-        // The default scene: 1000 spheres on 64 threads stay on one lane.
-        assert_eq!(lanes_for(64, 2, 1, 1000, w), (1, Bound::Work));
-        assert_eq!(lanes_for(256, 2, 40, 1000, w), (1, Bound::Work));
+        // Under a lane's cost, one lane however many threads and items.
+        assert_eq!(lanes_for(64, 2, 1, w - 1, w), (1, Bound::Work));
+        assert_eq!(lanes_for(256, 2, 40, w - 1, w), (1, Bound::Work));
         // Enough work, few blocks.
         assert_eq!(lanes_for(64, 64, 3, 100 * w, w), (3, Bound::Blocks));
         // Enough of both: the cores, then the threads.
@@ -259,6 +278,55 @@ mod tests {
         // Never none, whatever the limits.
         assert_eq!(lanes_for(0, 0, 0, 0, w).0, 1);
         assert_eq!(lanes_for(1, 2, 100, 100 * w, w), (1, Bound::Threads));
+    }
+
+    /// The rule is by work, not items: the same count of items gets one
+    /// lane where each is cheap and many where each is dear.
+    #[test]
+    fn lanes_follow_the_work_not_the_items() {
+        let w = LANE_COST_NS;
+        // 8000 free flights (3 ns each): 24 µs, one lane.
+        assert_eq!(
+            lanes_for(64, 64, 100, work_ns(8000, 3), w),
+            (1, Bound::Work)
+        );
+        // 8000 cluster members (800 ns each): 6.4 ms, every lane.
+        assert_eq!(
+            lanes_for(64, 64, 400, work_ns(8000, 800), w),
+            (64, Bound::Threads)
+        );
+        // Just under and just over two lanes' cost.
+        assert_eq!(lanes_for(8, 8, 100, 2 * w - 1, w).0, 1);
+        assert_eq!(lanes_for(8, 8, 100, 2 * w, w).0, 2);
+        // The product saturates rather than wrapping to a small figure.
+        assert_eq!(work_ns(usize::MAX, 2), usize::MAX);
+    }
+
+    /// A pass's parallel form runs only where the rule gives it two lanes.
+    #[test]
+    fn a_pass_stays_serial_under_two_lanes_of_work() {
+        struct Four;
+        impl super::Exec for Four {
+            fn lanes(&self) -> usize {
+                4
+            }
+            fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
+                (0..4).for_each(f);
+            }
+            fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {
+                a();
+                b();
+            }
+        }
+        let w = LANE_COST_NS;
+        assert_eq!(or_serial(&Four, 100, 2 * w - 1).lanes(), 1);
+        assert_eq!(or_serial(&Four, 100, 2 * w).lanes(), 4);
+        assert_eq!(
+            or_serial(&Four, 1, 100 * w).lanes(),
+            1,
+            "one block is one lane"
+        );
+        assert_eq!(or_serial(&Serial, 100, 100 * w).lanes(), 1);
     }
 
     #[test]

@@ -16,6 +16,16 @@ pub fn wide(exec: &dyn Exec) -> bool {
     wide_for(exec.lanes().min(exec.cores()))
 }
 
+/// Whether a pass over `items` items cut in blocks of `block` takes its
+/// parallel form on `exec`: on many lanes, and with two blocks of items to
+/// share (any two items for an executor that asks for every lane, so tests
+/// reach the form on small scenes).
+#[must_use]
+pub fn wide_pass(exec: &dyn Exec, items: usize, block: usize) -> bool {
+    let least = if exec.lane_cost() <= 1 { 1 } else { block };
+    wide(exec) && items >= 2 * least.max(1)
+}
+
 /// Whether a step on `lanes` lanes (each on a core) takes the parallel forms.
 #[must_use]
 pub fn wide_for(lanes: usize) -> bool {
@@ -24,7 +34,7 @@ pub fn wide_for(lanes: usize) -> bool {
 
 #[cfg(test)]
 mod tests {
-    use super::{WIDE_LANES, wide, wide_for};
+    use super::{WIDE_LANES, wide, wide_for, wide_pass};
     use crate::physics::exec::{Exec, Serial};
 
     struct Lanes(usize, usize);
@@ -56,5 +66,12 @@ mod tests {
         assert!(wide(&Lanes(64, 64)));
         // A pool of 64 on two cores runs two lanes at once: serial forms.
         assert!(!wide(&Lanes(64, 2)));
+    }
+
+    #[test]
+    fn a_pass_takes_its_parallel_form_from_two_blocks_on() {
+        assert!(!wide_pass(&Lanes(64, 64), 2 * 4096 - 1, 4096));
+        assert!(wide_pass(&Lanes(64, 64), 2 * 4096, 4096));
+        assert!(!wide_pass(&Lanes(2, 2), 1 << 20, 4096));
     }
 }

@@ -491,9 +491,11 @@ mod tests {
 
     #[test]
     fn the_pool_line_says_why_only_when_threads_wait() {
-        use crate::physics::exec::{Bound, Busy, MIN_WORK_PER_LANE, lanes_for};
+        use crate::physics::exec::{Bound, Busy, LANE_COST_NS, lanes_for, work_ns};
         let line = |threads, spheres: usize| {
-            let (busy, bound) = lanes_for(threads, 2, 100, spheres, MIN_WORK_PER_LANE);
+            // A pass of 10 ns a sphere: two lanes' worth from 8000 spheres.
+            let work = work_ns(spheres, 10);
+            let (busy, bound) = lanes_for(threads, 2, 100, work, LANE_COST_NS);
             let b = Busy {
                 busy,
                 threads,

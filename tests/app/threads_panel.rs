@@ -201,26 +201,33 @@ fn s_sorts_the_rows_by_cpu_and_back() {
     assert!(!st.threads_by_cpu);
 }
 
-/// A real pool frame of `exact` (8 000 spheres: enough for the frame's
+/// A real pool frame of `exact` (40 000 spheres: enough for the frame's
 /// readouts to spread over both lanes): the panel says one thread is busy,
-/// and why, not what the readouts kept busy.
+/// and why, not what the readouts kept busy; `swept` on the tour's 8 000
+/// spheres has the work for both (the lane rule is by work).
 #[test]
 fn the_pool_line_says_a_serial_model_keeps_one_thread_busy() {
     use ballpit::engine::{Engine, Settings, Threading};
     use ballpit::physics::ModelKind;
     use ballpit::scene::{SceneSpec, build_world};
-    let world = build_world(&SceneSpec {
-        count: Some(8000),
-        ..SceneSpec::default()
-    })
-    .unwrap();
-    for (model, want) in [
-        (ModelKind::Exact, "pool: 1 of 2 busy — exact is serial"),
-        // `swept` shares a step when the work pays for a second lane.
-        (ModelKind::Swept, "pool: 1 of 2 busy — 8000 spheres too few"),
+    let world = |count, radius| {
+        build_world(&SceneSpec {
+            count: Some(count),
+            radius,
+            ..SceneSpec::default()
+        })
+        .unwrap()
+    };
+    for (model, world, want) in [
+        (
+            ModelKind::Exact,
+            world(40_000, Some(0.004)),
+            "pool: 1 of 2 busy — exact is serial",
+        ),
+        (ModelKind::Swept, world(8000, None), "pool: 2 of 2 busy"),
     ] {
         let mut e = Engine::new(
-            world.clone(),
+            world,
             Settings {
                 model,
                 threading: Threading::Pool,

@@ -34,7 +34,7 @@ impl Exec for Lanes {
     fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
         (0..self.0).rev().for_each(f);
     }
-    fn min_work(&self) -> usize {
+    fn lane_cost(&self) -> usize {
         1
     }
     fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {

@@ -18,7 +18,7 @@ impl Exec for Shuffled {
     fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
         (0..self.lanes).rev().for_each(f);
     }
-    fn min_work(&self) -> usize {
+    fn lane_cost(&self) -> usize {
         1
     }
     fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {

@@ -176,7 +176,8 @@ impl Level {
         } else {
             exec
         };
-        let lanes = super::super::exec::lanes_of(exec, cells, staged.keys().len()).min(64);
+        let work = super::super::exec::work_ns(staged.keys().len(), super::NS_PER_KEY);
+        let lanes = super::super::exec::lanes_of(exec, cells, work).min(64);
         let bounds: Vec<usize> = (0..=lanes).map(|l| l * cells / lanes).collect();
         let tables = spans(
             &mut self.cell_start[..cells],

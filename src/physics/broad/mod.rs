@@ -13,7 +13,7 @@ mod pairs;
 mod place;
 mod sizing;
 
-use super::exec::{Exec, PerBlock, for_each_block, for_each_chunk};
+use super::exec::{Exec, PerBlock, for_each_block, for_each_chunk, or_serial, work_ns};
 use super::sphere::Sphere;
 use entry::{Ball, Entry, Source};
 use glam::DVec3;
@@ -22,8 +22,10 @@ use sizing::{cell_for, cell_of_sample};
 
 /// At most this many spheres are tested against everything.
 const ALL_PAIRS_MAX: usize = 24;
-/// Fewer spheres than this are sorted into the first level on one lane.
-const LANES_MIN_SPHERES: usize = 4096;
+/// Predicted nanoseconds of staging (or keying) a sphere, and of placing
+/// its key in the first level's sort (docs/threading.md).
+const NS_PER_STAGE: usize = 8;
+const NS_PER_KEY: usize = 6;
 /// Spheres per parallel block while binning.
 const BUILD_BLOCK: usize = 4096;
 /// Planes of cells per parallel block when finding the balls on faces.
@@ -143,7 +145,14 @@ impl Grid {
         if n >= KEYED_MIN {
             self.staged = Vec::new();
             self.build_keyed(spheres, ball, exec);
-        } else if n < LANES_MIN_SPHERES || exec.lanes() <= 1 {
+        } else if or_serial(
+            exec,
+            n.div_ceil(BUILD_BLOCK),
+            work_ns(n, NS_PER_STAGE + NS_PER_KEY),
+        )
+        .lanes()
+            <= 1
+        {
             self.build_staged_one_lane(spheres, ball, exec);
         } else {
             self.build_staged(spheres, ball, exec);
@@ -151,7 +160,7 @@ impl Grid {
     }
 
     /// The first level from staged records on one lane. Under
-    /// [`LANES_MIN_SPHERES`], waking other threads costs more than the
+    /// two lanes of work (the lane rule), waking other threads costs more than the
     /// sort; the layout is the same for any number of lanes.
     fn build_staged_one_lane<T: Sync>(
         &mut self,
@@ -196,15 +205,21 @@ impl Grid {
         self.wide.ensure(blocks);
         let level = &self.levels[0];
         let wide = &self.wide;
-        for_each_chunk(exec, &mut self.staged, BUILD_BLOCK, &|b, chunk| {
-            let mut wide = wide[b].lock();
-            wide.clear();
-            let first = (b * BUILD_BLOCK) as u32;
-            let mine = chunk.iter_mut().zip(&spheres[b * BUILD_BLOCK..]);
-            for ((slot, s), id) in mine.zip(first..) {
-                *slot = level.stage(ball(s), id, &mut wide);
-            }
-        });
+        for_each_chunk(
+            exec,
+            &mut self.staged,
+            BUILD_BLOCK,
+            NS_PER_STAGE,
+            &|b, chunk| {
+                let mut wide = wide[b].lock();
+                wide.clear();
+                let first = (b * BUILD_BLOCK) as u32;
+                let mine = chunk.iter_mut().zip(&spheres[b * BUILD_BLOCK..]);
+                for ((slot, s), id) in mine.zip(first..) {
+                    *slot = level.stage(ball(s), id, &mut wide);
+                }
+            },
+        );
         self.levels[0].fill_lanes(&self.staged[..], exec, None);
         for w in &self.wide[..blocks] {
             self.rest.extend_from_slice(&w.lock());
@@ -272,22 +287,28 @@ impl Grid {
         self.widest.ensure(blocks);
         let level = &self.levels[0];
         let (wide, widest) = (&self.wide, &self.widest);
-        for_each_chunk(exec, &mut self.keys, BUILD_BLOCK, &|b, chunk| {
-            let mut wide = wide[b].lock();
-            wide.clear();
-            let mut reach_max = 0.0f64;
-            let first = (b * BUILD_BLOCK) as u32;
-            let mine = chunk.iter_mut().zip(&spheres[b * BUILD_BLOCK..]);
-            for ((slot, s), id) in mine.zip(first..) {
-                let e = level.stage(ball(s), id, &mut wide);
-                // Not `f64::max`: see `fill_lanes`.
-                if e.key != WIDE && e.ball.reach > reach_max {
-                    reach_max = e.ball.reach;
+        for_each_chunk(
+            exec,
+            &mut self.keys,
+            BUILD_BLOCK,
+            NS_PER_STAGE,
+            &|b, chunk| {
+                let mut wide = wide[b].lock();
+                wide.clear();
+                let mut reach_max = 0.0f64;
+                let first = (b * BUILD_BLOCK) as u32;
+                let mine = chunk.iter_mut().zip(&spheres[b * BUILD_BLOCK..]);
+                for ((slot, s), id) in mine.zip(first..) {
+                    let e = level.stage(ball(s), id, &mut wide);
+                    // Not `f64::max`: see `fill_lanes`.
+                    if e.key != WIDE && e.ball.reach > reach_max {
+                        reach_max = e.ball.reach;
+                    }
+                    *slot = e.key;
                 }
-                *slot = e.key;
-            }
-            *widest[b].lock() = reach_max;
-        });
+                *widest[b].lock() = reach_max;
+            },
+        );
         let keyed = Keyed {
             keys: &self.keys,
             spheres,

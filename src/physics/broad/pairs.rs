@@ -4,7 +4,12 @@
 use super::entry::Ball;
 use super::level::{Level, within};
 use super::{Grid, Pair};
-use crate::physics::exec::{Exec, for_each_block_of};
+use crate::physics::exec::{Exec, for_each_block_of, work_ns};
+
+/// Predicted nanoseconds a cell entry costs in `pairs` and in
+/// `scan_within` (measured per block, docs/threading.md).
+const NS_PER_ENTRY_PAIRS: usize = 50;
+const NS_PER_ENTRY_SCAN: usize = 30;
 use std::cell::Cell;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -96,15 +101,20 @@ impl Grid {
         let units = self.units();
         self.slots.ensure(units.len());
         let this = &*self;
-        for_each_block_of(exec, units.len(), this.entries(), &|u| {
-            let mut v = this.slots[u].lock();
-            v.clear();
-            this.unit_pairs(units[u], &|| true, &mut |i, j| {
-                if keep(i, j) {
-                    v.push((i, j));
-                }
-            });
-        });
+        for_each_block_of(
+            exec,
+            units.len(),
+            work_ns(this.entries(), NS_PER_ENTRY_PAIRS),
+            &|u| {
+                let mut v = this.slots[u].lock();
+                v.clear();
+                this.unit_pairs(units[u], &|| true, &mut |i, j| {
+                    if keep(i, j) {
+                        v.push((i, j));
+                    }
+                });
+            },
+        );
         for s in &self.slots[..units.len()] {
             out.extend_from_slice(&s.lock());
         }
@@ -163,43 +173,48 @@ impl Grid {
         }
         let this = &*self;
         let found = AtomicUsize::new(0);
-        for_each_block_of(exec, units.len(), this.entries(), &|u| {
-            let mut v = STORE.then(|| this.slots[u].lock());
-            if let Some(v) = &mut v {
-                v.clear();
-            }
-            // Counted here, added to the total now and then: one shared
-            // counter touched per pair would cost more than the pair.
-            // The total is read then too: a unit that finds few pairs costs
-            // little, whatever the others found.
-            let (mine, told, over) = (Cell::new(0usize), Cell::new(0usize), Cell::new(false));
-            let tell = || {
-                let new = mine.get() - told.get();
-                let before = found.fetch_add(new, Ordering::Relaxed);
-                told.set(mine.get());
-                over.set(before + new > limit);
-            };
-            let go = || {
-                if mine.get() - told.get() >= LIMIT_FLUSH {
-                    tell();
-                }
-                !over.get()
-            };
-            let mut take = |i, j| {
-                if !keep(i, j) {
-                    return;
-                }
+        for_each_block_of(
+            exec,
+            units.len(),
+            work_ns(this.entries(), NS_PER_ENTRY_SCAN),
+            &|u| {
+                let mut v = STORE.then(|| this.slots[u].lock());
                 if let Some(v) = &mut v {
-                    v.push((i, j));
+                    v.clear();
                 }
-                mine.set(mine.get() + 1);
-            };
-            over.set(found.load(Ordering::Relaxed) > limit);
-            if go() {
-                this.unit_pairs(units[u], &go, &mut take);
-            }
-            tell();
-        });
+                // Counted here, added to the total now and then: one shared
+                // counter touched per pair would cost more than the pair.
+                // The total is read then too: a unit that finds few pairs costs
+                // little, whatever the others found.
+                let (mine, told, over) = (Cell::new(0usize), Cell::new(0usize), Cell::new(false));
+                let tell = || {
+                    let new = mine.get() - told.get();
+                    let before = found.fetch_add(new, Ordering::Relaxed);
+                    told.set(mine.get());
+                    over.set(before + new > limit);
+                };
+                let go = || {
+                    if mine.get() - told.get() >= LIMIT_FLUSH {
+                        tell();
+                    }
+                    !over.get()
+                };
+                let mut take = |i, j| {
+                    if !keep(i, j) {
+                        return;
+                    }
+                    if let Some(v) = &mut v {
+                        v.push((i, j));
+                    }
+                    mine.set(mine.get() + 1);
+                };
+                over.set(found.load(Ordering::Relaxed) > limit);
+                if go() {
+                    this.unit_pairs(units[u], &go, &mut take);
+                }
+                tell();
+            },
+        );
         (found.into_inner() <= limit, units.len())
     }
 }

@@ -8,14 +8,15 @@ use super::partition::{Partition, Slot};
 use super::path_ball;
 use super::stats::RoundStats;
 use crate::physics::broad::Grid;
-use crate::physics::exec::{Exec, Serial, for_each_chunk};
+use crate::physics::exec::{Exec, for_each_chunk, or_serial, work_ns};
 use crate::physics::sphere::Sphere;
 use crate::physics::wide::wide;
 use glam::DVec3;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// Fewer grown balls than this are compared on one lane.
-const LANES_MIN_BALLS: usize = 2048;
+/// Predicted nanoseconds of making a grown ball and comparing it with its
+/// neighbours (docs/threading.md).
+const NS_PER_BALL: usize = 50;
 /// Slots per block when making their balls in parallel.
 const BALL_BLOCK: usize = 2048;
 
@@ -215,12 +216,18 @@ impl Conflicts {
         if wide(exec) {
             self.balls.resize(m, (DVec3::ZERO, 0.0));
             let ids = &part.ids;
-            for_each_chunk(exec, &mut self.balls, BALL_BLOCK, &|b, chunk| {
-                for (k, ball) in chunk.iter_mut().enumerate() {
-                    let s = b * BALL_BLOCK + k;
-                    *ball = fin.ball(s, ids[s], spheres, dt);
-                }
-            });
+            for_each_chunk(
+                exec,
+                &mut self.balls,
+                BALL_BLOCK,
+                NS_PER_BALL,
+                &|b, chunk| {
+                    for (k, ball) in chunk.iter_mut().enumerate() {
+                        let s = b * BALL_BLOCK + k;
+                        *ball = fin.ball(s, ids[s], spheres, dt);
+                    }
+                },
+            );
         } else {
             for s in 0..m {
                 self.balls.push(fin.ball(s, part.ids[s], spheres, dt));
@@ -259,10 +266,10 @@ impl Conflicts {
     }
 }
 
-/// `exec`, or the calling thread when `n` items are too few to be worth
-/// handing to other threads (each hand-off costs tens of microseconds).
+/// `exec`, or the calling thread when `n` balls are too little work to
+/// be worth handing to other threads (the lane rule).
 fn small(exec: &dyn Exec, n: usize) -> &dyn Exec {
-    if n < LANES_MIN_BALLS { &Serial } else { exec }
+    or_serial(exec, n.div_ceil(BALL_BLOCK), work_ns(n, NS_PER_BALL))
 }
 
 /// Relative margin on the touching distance when comparing two paths: far

@@ -3,7 +3,7 @@
 //! members). A stable sort has one answer, so its serial form and its
 //! parallel one (for many lanes, `wide.rs`) give the same, however cut.
 use crate::physics::exec::{Exec, PerBlock, for_each_block, spans};
-use crate::physics::wide::wide;
+use crate::physics::wide::wide_pass;
 use parking_lot::Mutex;
 use std::ops::Range;
 
@@ -25,7 +25,7 @@ impl<T> Default for Buckets<T> {
 /// Whether grouping `len` source items into `keys` keys on `exec` takes
 /// the parallel form ([`group_wide`]).
 pub(super) fn wide_group(exec: &dyn Exec, keys: usize, len: usize) -> bool {
-    wide(exec) && keys > 0 && len >= 2 * ITEM_BLOCK.min(exec.min_work()).max(1)
+    keys > 0 && wide_pass(exec, len, ITEM_BLOCK)
 }
 
 /// Groups `items` by key in `0..keys`, keeping their order within a key:
@@ -158,7 +158,7 @@ mod tests {
         fn cores(&self) -> usize {
             64
         }
-        fn min_work(&self) -> usize {
+        fn lane_cost(&self) -> usize {
             1
         }
         fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {

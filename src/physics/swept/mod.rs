@@ -31,8 +31,8 @@ mod stats;
 
 use super::broad::Pair;
 use super::contact::pair_toi;
-use super::detect::{Detection, SPHERE_BLOCK};
-use super::exec::{Exec, PerBlock, for_each_block_of, for_each_chunk};
+use super::detect::{Detection, NS_PER_FLIGHT, SPHERE_BLOCK};
+use super::exec::{Exec, PerBlock, for_each_block_of, for_each_chunk, work_ns};
 use super::flight::fly;
 use super::model::{Model, ModelKind};
 use super::sphere::{Sphere, overlap_rel};
@@ -50,6 +50,8 @@ const REACH_SLACK: f64 = 1.0 + 1e-9;
 /// Candidate pairs per parallel block when sorting them into meeting and
 /// merely near.
 const PAIR_BLOCK: usize = 4096;
+/// Predicted nanoseconds of sorting one near pair (docs/threading.md).
+const NS_PER_PAIR_SORT: usize = 70;
 /// The work budget of one step, in pair checks (pairs detection finds,
 /// spheres a rescan looks at, weights per event: `cluster.rs`): a base plus
 /// so much per sphere, so the worst step of 1 000 spheres (120 M) costs
@@ -258,11 +260,17 @@ impl Swept {
         // Everyone flies straight; then the spheres with events take their
         // run's end, and the counters are summed in sphere order: the same
         // bits on any lanes and however the clusters fell.
-        for_each_chunk(exec, &mut world.spheres, SPHERE_BLOCK, &|_, chunk| {
-            for s in chunk {
-                s.pos += s.vel * dt;
-            }
-        });
+        for_each_chunk(
+            exec,
+            &mut world.spheres,
+            SPHERE_BLOCK,
+            NS_PER_FLIGHT,
+            &|_, chunk| {
+                for s in chunk {
+                    s.pos += s.vel * dt;
+                }
+            },
+        );
         let c = &mut world.counters;
         let mut capped = None;
         for (m, cap) in self.rounds.results() {
@@ -338,7 +346,7 @@ impl Swept {
         self.sorted.ensure(blocks);
         self.overlap.ensure(blocks);
         let (sorted, overlap) = (&self.sorted, &self.overlap);
-        for_each_block_of(exec, blocks, pairs.len(), &|b| {
+        for_each_block_of(exec, blocks, work_ns(pairs.len(), NS_PER_PAIR_SORT), &|b| {
             let mut guard = sorted[b].lock();
             let (meets, near) = &mut *guard;
             meets.clear();

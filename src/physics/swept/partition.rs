@@ -6,7 +6,7 @@
 //! numbered and the first round laid out in parallel, to the same bits.
 use super::group::{Buckets, group, group_wide, wide_group};
 use crate::physics::exec::{Exec, PerBlock, for_each_block, spans};
-use crate::physics::wide::wide;
+use crate::physics::wide::wide_pass;
 use parking_lot::Mutex;
 
 /// Spheres per block when numbering the slots in parallel.
@@ -124,7 +124,7 @@ impl Partition {
         for &i in hits {
             self.slot[i as usize] = Slot(0);
         }
-        if wide(exec) && n >= 2 * NUMBER_BLOCK.min(exec.min_work()) {
+        if wide_pass(exec, n, NUMBER_BLOCK) {
             self.number_wide(exec);
         } else {
             for (i, slot) in self.slot.iter_mut().enumerate() {
@@ -414,7 +414,7 @@ impl Partition {
     pub fn roots_into(&mut self, exec: &dyn Exec, out: &mut Vec<Slot>) {
         let m = self.ids.len();
         out.clear();
-        if !(wide(exec) && m >= 2 * ROOT_BLOCK.min(exec.min_work())) {
+        if !wide_pass(exec, m, ROOT_BLOCK) {
             out.extend((0..m).map(|s| self.find(Slot::at(s))));
             return;
         }

@@ -31,11 +31,12 @@ use super::conflicts::{Conflicts, Finished};
 use super::partition::{Batch, Partition, Slot};
 use super::stats::RoundStats;
 use crate::physics::broad::Grid;
-use crate::physics::exec::{Exec, PerBlock, Serial, lanes_of};
+use crate::physics::exec::{Exec, PerBlock, Serial, lanes_of, or_serial, work_ns};
 use crate::physics::sphere::Sphere;
 
-/// Fewer spheres with events than this run their clusters on one lane.
-const LANES_MIN_MEMBERS: usize = 512;
+/// Predicted nanoseconds of running one cluster member through a round
+/// (docs/threading.md).
+const NS_PER_MEMBER: usize = 800;
 /// Clusters per parallel block.
 const CLUSTER_BLOCK: usize = 16;
 /// Rounds run in parallel before the rest run as one absorbing cluster.
@@ -149,10 +150,11 @@ impl Rounds {
                 self.stats.reruns += self.batch.todo.len();
             }
             // A few events are not worth waking other threads for.
-            let lanes: &dyn Exec = if absorb || self.batch.order.len() < LANES_MIN_MEMBERS {
+            let lanes: &dyn Exec = if absorb {
                 &Serial
             } else {
-                exec
+                let blocks = self.batch.todo.len().div_ceil(CLUSTER_BLOCK);
+                or_serial(exec, blocks, work_ns(self.batch.order.len(), NS_PER_MEMBER))
             };
             self.reserve(lanes);
             let sh = Shared {
@@ -262,7 +264,7 @@ impl Rounds {
         let blocks = self.batch.todo.len().div_ceil(CLUSTER_BLOCK);
         let (runs, outs, todo) = (&self.runs, &self.outs, &self.batch.todo);
         let (order, pairs) = (&self.batch.order, &self.batch.pairs);
-        let lanes = lanes_of(exec, blocks, order.len());
+        let lanes = lanes_of(exec, blocks, work_ns(order.len(), NS_PER_MEMBER));
         exec.for_blocks(lanes, blocks, &|lane, b| {
             let mut run = runs[lane].lock();
             let mut out = outs[b].lock();
