@@ -12,9 +12,8 @@ use parking_lot::Mutex;
 /// Spheres per parallel block; fixed so results never depend on the number
 /// of threads.
 pub(crate) const SPHERE_BLOCK: usize = 2048;
-/// Predicted nanoseconds of a sphere's straight flight over a step, and of
-/// its test against the walls (docs/threading.md).
-pub(crate) const NS_PER_FLIGHT: usize = 3;
+/// Predicted nanoseconds of a sphere's test against the walls
+/// (docs/threading.md).
 const NS_PER_WALL_TEST: usize = 1;
 
 /// Where detection leaves its answers, kept between steps to reuse memory.

@@ -5,8 +5,9 @@
 //! velocities carry energy). Overlaps are found on the moved positions,
 //! before the wall mirror.
 use super::contact::resolve_pair;
-use super::detect::{Detection, NS_PER_FLIGHT, SPHERE_BLOCK};
-use super::exec::{Exec, for_each_chunk};
+use super::detect::Detection;
+use super::exec::Exec;
+use super::flight::fly_straight;
 use super::model::{Model, ModelKind};
 use super::sphere::Sphere;
 use super::world::World;
@@ -46,17 +47,7 @@ impl Model for Discrete {
 impl Discrete {
     fn step(&mut self, world: &mut World, dt: f64, exec: &dyn Exec) {
         let size = world.size;
-        for_each_chunk(
-            exec,
-            &mut world.spheres,
-            SPHERE_BLOCK,
-            NS_PER_FLIGHT,
-            &|_, chunk| {
-                for s in chunk {
-                    s.pos += s.vel * dt;
-                }
-            },
-        );
+        fly_straight(exec, &mut world.spheres, dt);
         let sp = &world.spheres;
         let overlapping = |i: u32, j: u32| {
             let (a, b) = (&sp[i as usize], &sp[j as usize]);

@@ -1,7 +1,24 @@
 //! Free flight with wall bounces only, in closed form: along each axis the
 //! motion between the walls is a triangle wave, so a sphere that crosses many
-//! box lengths in one step costs the same as one that crosses none.
+//! box lengths in one step costs the same as one that crosses none. And
+//! the straight flight of a per-step model, where the walls come after.
+use super::detect::SPHERE_BLOCK;
+use super::exec::{Exec, for_each_chunk};
 use super::sphere::Sphere;
+
+/// Predicted nanoseconds of a sphere's straight flight over a step
+/// (docs/threading.md).
+const NS_PER_FLIGHT: usize = 3;
+
+/// Moves every sphere along its velocity for `dt`, walls or not: the
+/// per-step models mend what crossed a wall or met a sphere afterwards.
+pub fn fly_straight(exec: &dyn Exec, spheres: &mut [Sphere], dt: f64) {
+    for_each_chunk(exec, spheres, SPHERE_BLOCK, NS_PER_FLIGHT, &|_, chunk| {
+        for s in chunk {
+            s.pos += s.vel * dt;
+        }
+    });
+}
 
 /// Moves `s` for time `t` bouncing off the walls of `[0, size]^3`. Returns
 /// the momentum given to the walls and the number of wall collisions.

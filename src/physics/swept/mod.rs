@@ -31,9 +31,9 @@ mod stats;
 
 use super::broad::Pair;
 use super::contact::pair_toi;
-use super::detect::{Detection, NS_PER_FLIGHT, SPHERE_BLOCK};
-use super::exec::{Exec, PerBlock, for_each_block_of, for_each_chunk, work_ns};
-use super::flight::fly;
+use super::detect::Detection;
+use super::exec::{Exec, PerBlock, for_each_block_of, work_ns};
+use super::flight::{fly, fly_straight};
 use super::model::{Model, ModelKind};
 use super::sphere::{Sphere, overlap_rel};
 use super::wide::wide;
@@ -260,17 +260,7 @@ impl Swept {
         // Everyone flies straight; then the spheres with events take their
         // run's end, and the counters are summed in sphere order: the same
         // bits on any lanes and however the clusters fell.
-        for_each_chunk(
-            exec,
-            &mut world.spheres,
-            SPHERE_BLOCK,
-            NS_PER_FLIGHT,
-            &|_, chunk| {
-                for s in chunk {
-                    s.pos += s.vel * dt;
-                }
-            },
-        );
+        fly_straight(exec, &mut world.spheres, dt);
         let c = &mut world.counters;
         let mut capped = None;
         for (m, cap) in self.rounds.results() {
