@@ -78,23 +78,7 @@ impl Frame {
     /// (docs/design.md, bench JSON: `wall_seconds` covers any detection for the readouts).
     /// Copying the spheres out for the screen is not timed.
     fn run_here(&mut self) {
-        let t0 = Instant::now();
-        let steps = self.step(t0);
-        let overlap = self
-            .model
-            .max_overlap_rel(&self.world, self.settings.dt, &*self.exec)
-            .map_or_else(
-                || self.scratch.measure(&self.world, &*self.exec),
-                Overlap::complete,
-            );
-        // A readout cut at its budget is a lower bound: the promise is not
-        // known kept (and which pairs were seen may differ between modes).
-        self.model.overlap_read(if overlap.partial {
-            f64::INFINITY
-        } else {
-            overlap.deepest_rel
-        });
-        let physics_seconds = t0.elapsed().as_secs_f64();
+        let (steps, overlap, physics_seconds) = self.timed();
         self.number += 1;
         let snap = &mut self.snap;
         snap.fill_world(
@@ -114,6 +98,29 @@ impl Frame {
         snap.switch_notice = switch_notice(self.chosen, snap.choice.as_ref());
         self.chosen = snap.choice.as_ref().map(|c| c.model);
         snap.notice.clone_from(&self.notice);
+    }
+
+    /// The frame's physics, all of it timed: its steps and the overlap
+    /// readout (which `auto` checks its promise against). The steps done,
+    /// the readout and the wall seconds.
+    pub(crate) fn timed(&mut self) -> (u64, Overlap, f64) {
+        let t0 = Instant::now();
+        let steps = self.step(t0);
+        let overlap = self
+            .model
+            .max_overlap_rel(&self.world, self.settings.dt, &*self.exec)
+            .map_or_else(
+                || self.scratch.measure(&self.world, &*self.exec),
+                Overlap::complete,
+            );
+        // A readout cut at its budget is a lower bound: the promise is not
+        // known kept (and which pairs were seen may differ between modes).
+        self.model.overlap_read(if overlap.partial {
+            f64::INFINITY
+        } else {
+            overlap.deepest_rel
+        });
+        (steps, overlap, t0.elapsed().as_secs_f64())
     }
 
     /// Run the frame's steps in whole chunks, each sized from the mean step

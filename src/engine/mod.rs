@@ -16,12 +16,14 @@
 //! world and a mode switch between frames cannot lose or repeat anything.
 mod frame;
 mod pool;
+mod replay;
 mod snapshot;
 mod span;
 mod start;
 mod worker;
 
 pub use pool::{KEPT_WORKER, PoolExec, Refused, SPLIT_ROLES, SplitExec, kept_pool, pool_name};
+pub use replay::replay;
 pub use snapshot::{Snapshot, SphereView};
 pub use span::{SpanExec, WorkSpan, makespan};
 pub use start::Rebuild;
