@@ -16,6 +16,7 @@
 //! world and a mode switch between frames cannot lose or repeat anything.
 mod frame;
 mod pool;
+mod probe;
 mod replay;
 mod snapshot;
 mod span;
@@ -480,7 +481,7 @@ impl Engine {
                             continue;
                         }
                     }
-                    frame.world.touch();
+                    self.edited(frame);
                     frame.model = self.settings.model.build();
                     frame.notice = None;
                     frame.energy_reset = frame.world.kinetic_energy();
@@ -517,6 +518,9 @@ impl Engine {
     #[allow(clippy::unused_self)] // one of the engine's steps, called as one
     fn edited(&self, frame: &mut Frame) {
         frame.world.touch();
+        if let Some(p) = frame.probe.as_mut() {
+            p.forget();
+        }
         frame.energy_reset = frame.world.kinetic_energy();
     }
 
