@@ -1,5 +1,5 @@
 //! `ballpit bench`: run a scene headless and print one JSON line.
-use crate::engine::{Command, Engine, Settings};
+use crate::engine::{Command, Engine, Settings, Threading};
 use crate::physics::World;
 use serde::Serialize;
 
@@ -47,6 +47,18 @@ pub struct BenchReport {
     /// on more than one lane; the rest is the step's serial part (null in
     /// the other modes).
     pub parallel_seconds: Option<f64>,
+    /// In `pool` of `K` threads: the CPU seconds of the same steps from the
+    /// same start replayed after the timed run on a [`SpanExec`] of `K`
+    /// lanes (`engine::replay`), its span on those `K` lanes and its
+    /// parallelism, work over the span on unlimited lanes (so at least
+    /// `work_seconds / span_seconds`). A measurement apart from the timed
+    /// run, not in `wall_seconds` or `steps_per_second`; null in the other
+    /// modes.
+    ///
+    /// [`SpanExec`]: crate::engine::SpanExec
+    pub work_seconds: Option<f64>,
+    pub span_seconds: Option<f64>,
+    pub parallelism: Option<f64>,
     /// The 1-minute load average of the host (`/proc/loadavg`) before and
     /// after stepping, so a reader can judge the timings; empty elsewhere.
     pub load_average: Vec<f64>,
@@ -162,7 +174,7 @@ pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(Ben
     let measured = Measured {
         wall,
         max_err,
-        parallel_seconds: (settings.threading == crate::engine::Threading::Pool)
+        parallel_seconds: (settings.threading == Threading::Pool)
             .then(|| engine.parallel_seconds().unwrap_or(0.0) - parallel_before),
         physics_cpu_seconds: physics_cpu(&engine, &physics_threads, &cpu_before),
         first_frame,
@@ -189,6 +201,43 @@ pub fn run(world: World, settings: &Settings, steps: u64) -> anyhow::Result<(Ben
         &last,
     );
     Ok((report, world))
+}
+
+/// `ballpit bench`: [`run`], and for a pool of `K` threads the same steps
+/// from the same start replayed on `K` lanes one after another on this
+/// thread, for `work_seconds`, `span_seconds` and `parallelism`. The start
+/// is copied for the replay (the copy is in `peak_rss_bytes`).
+///
+/// # Errors
+/// As [`run`]; and when the replay ends in other bits than the timed run.
+pub fn run_spanned(
+    world: World,
+    settings: &Settings,
+    steps: u64,
+) -> anyhow::Result<(BenchReport, World)> {
+    if settings.threading != Threading::Pool {
+        return run(world, settings, steps);
+    }
+    let start = world.clone();
+    let (report, end) = run(world, settings, steps)?;
+    let lanes = report.threads.clamp(1, crate::engine::MAX_THREADS);
+    let replayed = Settings {
+        tick: settings.tick.max(1),
+        ..*settings
+    };
+    let (ws, again) = crate::engine::replay(start, replayed, steps, lanes);
+    if again.spheres != end.spheres || again.counters != end.counters {
+        anyhow::bail!(
+            "the replay of the run on {lanes} lanes (for work_seconds and span_seconds) ended in other bits than the timed run: a bug, please report it"
+        );
+    }
+    let report = BenchReport {
+        work_seconds: Some(ws.work),
+        span_seconds: Some(ws.span),
+        parallelism: Some(ws.parallelism()),
+        ..report
+    };
+    Ok((report, end))
 }
 
 /// The energy's change from `e0`, relative where `e0` is not 0.
@@ -244,6 +293,9 @@ fn report_of(
         physics_cpu_seconds: m.physics_cpu_seconds,
         first_frame: m.first_frame,
         parallel_seconds: m.parallel_seconds,
+        work_seconds: None,
+        span_seconds: None,
+        parallelism: None,
         load_average: m.load_average,
         steps_per_second: per_sec(steps as f64),
         sphere_steps_per_second: per_sec(steps as f64 * n as f64),

@@ -31,7 +31,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 .as_deref()
                 .map(scene::csv_io::create)
                 .transpose()?;
-            let (report, world) = bench::run(world, &settings, args.steps)?;
+            let (report, world) = bench::run_spanned(world, &settings, args.steps)?;
             if let Some(file) = dump {
                 file.write(&world)?;
                 if world.max_overlap_rel() > 0.0 {

@@ -43,6 +43,18 @@ pub const BENCH_FIELDS: &[(&str, &str)] = &[
         "pool only: the part of wall_seconds in sections on more than one lane (null otherwise)",
     ),
     (
+        "work_seconds",
+        "pool of K only: CPU seconds of the same steps replayed after the timed run on K lanes one after another (not in wall_seconds; null otherwise)",
+    ),
+    (
+        "span_seconds",
+        "pool only: that replay's span on K lanes, its longest chain of work that must run in order (null otherwise)",
+    ),
+    (
+        "parallelism",
+        "pool only: work over the span on unlimited lanes (Cilk's T1/Tinf, at least work/span; null otherwise)",
+    ),
+    (
         "load_average",
         "[start, end] 1-minute load average of the host (/proc/loadavg)",
     ),

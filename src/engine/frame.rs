@@ -1,8 +1,10 @@
 //! One frame's worth of work, moved whole to whichever thread runs it: the
 //! world, the model, the executor, and the back snapshot to fill.
 use super::Settings;
+use super::probe::Probe;
 use super::snapshot::{Overlap, OverlapScratch, Snapshot};
 use crate::physics::auto::Choice;
+use crate::physics::exec::Busy;
 use crate::physics::{Exec, Model, ModelKind, World};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -32,6 +34,13 @@ pub(crate) struct Frame {
     /// while a long frame runs.
     pub progress: Arc<AtomicU64>,
     scratch: OverlapScratch,
+    /// The parallelism of the running scene, for a screen (`None` headless:
+    /// `bench` measures its own, apart from the timed run).
+    pub probe: Option<Probe>,
+    /// This frame's first step ran on the probe, not the pool; and the
+    /// pool's widest section of the frame before, which that step hid.
+    probed: bool,
+    busy: Option<Busy>,
     /// What `auto` ran in the last frame, to tell a switch (`None` for the
     /// other models; kept across a new `auto`, as the tolerance keys make).
     chosen: Option<ModelKind>,
@@ -61,6 +70,9 @@ impl Frame {
             hold: false,
             progress: Arc::default(),
             scratch: OverlapScratch::default(),
+            probe: views.then(Probe::default),
+            probed: false,
+            busy: None,
             chosen: None,
         }
     }
@@ -78,23 +90,7 @@ impl Frame {
     /// (docs/design.md, bench JSON: `wall_seconds` covers any detection for the readouts).
     /// Copying the spheres out for the screen is not timed.
     fn run_here(&mut self) {
-        let t0 = Instant::now();
-        let steps = self.step(t0);
-        let overlap = self
-            .model
-            .max_overlap_rel(&self.world, self.settings.dt, &*self.exec)
-            .map_or_else(
-                || self.scratch.measure(&self.world, &*self.exec),
-                Overlap::complete,
-            );
-        // A readout cut at its budget is a lower bound: the promise is not
-        // known kept (and which pairs were seen may differ between modes).
-        self.model.overlap_read(if overlap.partial {
-            f64::INFINITY
-        } else {
-            overlap.deepest_rel
-        });
-        let physics_seconds = t0.elapsed().as_secs_f64();
+        let (steps, overlap, physics_seconds) = self.timed();
         self.number += 1;
         let snap = &mut self.snap;
         snap.fill_world(
@@ -114,6 +110,38 @@ impl Frame {
         snap.switch_notice = switch_notice(self.chosen, snap.choice.as_ref());
         self.chosen = snap.choice.as_ref().map(|c| c.model);
         snap.notice.clone_from(&self.notice);
+        snap.parallelism = self.probe.as_ref().and_then(|p| p.value);
+        if self.probed {
+            snap.pool_busy = match (snap.pool_busy, self.busy) {
+                (Some(now), Some(was)) if was.busy > now.busy => Some(was),
+                (None, was) => was,
+                (now, _) => now,
+            };
+        }
+        self.busy = snap.pool_busy;
+    }
+
+    /// The frame's physics, all of it timed: its steps and the overlap
+    /// readout (which `auto` checks its promise against). The steps done,
+    /// the readout and the wall seconds.
+    pub(crate) fn timed(&mut self) -> (u64, Overlap, f64) {
+        let t0 = Instant::now();
+        let steps = self.step(t0);
+        let overlap = self
+            .model
+            .max_overlap_rel(&self.world, self.settings.dt, &*self.exec)
+            .map_or_else(
+                || self.scratch.measure(&self.world, &*self.exec),
+                Overlap::complete,
+            );
+        // A readout cut at its budget is a lower bound: the promise is not
+        // known kept (and which pairs were seen may differ between modes).
+        self.model.overlap_read(if overlap.partial {
+            f64::INFINITY
+        } else {
+            overlap.deepest_rel
+        });
+        (steps, overlap, t0.elapsed().as_secs_f64())
     }
 
     /// Run the frame's steps in whole chunks, each sized from the mean step
@@ -135,6 +163,17 @@ impl Frame {
         let cuts_freely = self.settings.model.cuts_freely();
         let (mut done, mut chunk) = (0_u64, if cuts_freely { 1 } else { tick });
         self.progress.store(0, Ordering::Relaxed);
+        let ran = self
+            .settings
+            .model
+            .running(self.model.choice().map(|c| c.model));
+        let settings = self.settings;
+        let mut probe = self
+            .probe
+            .as_mut()
+            .filter(|_| tick > 0)
+            .and_then(|p| p.wants(&settings, ran, t0).then_some(p));
+        self.probed = probe.is_some();
         loop {
             let want = if budget.is_some() {
                 if cuts_freely { chunk } else { 1 }
@@ -144,7 +183,16 @@ impl Frame {
             if want == 0 {
                 return done;
             }
-            self.model.advance(&mut self.world, dt, want, &*self.exec);
+            // The frame's first advance, when the probe is due, is measured
+            // on the span executor (the same bits as on the pool).
+            if let Some(p) = probe.take() {
+                let (model, world) = (&mut self.model, &mut self.world);
+                p.measure(self.settings.threads, &mut |exec| {
+                    model.advance(world, dt, want, exec);
+                });
+            } else {
+                self.model.advance(&mut self.world, dt, want, &*self.exec);
+            }
             done += want;
             self.progress.store(done, Ordering::Relaxed);
             let spent = t0.elapsed();

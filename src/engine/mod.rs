@@ -16,12 +16,15 @@
 //! world and a mode switch between frames cannot lose or repeat anything.
 mod frame;
 mod pool;
+mod probe;
+mod replay;
 mod snapshot;
 mod span;
 mod start;
 mod worker;
 
 pub use pool::{KEPT_WORKER, PoolExec, Refused, SPLIT_ROLES, SplitExec, kept_pool, pool_name};
+pub use replay::replay;
 pub use snapshot::{Snapshot, SphereView};
 pub use span::{SpanExec, WorkSpan, makespan};
 pub use start::Rebuild;
@@ -478,7 +481,7 @@ impl Engine {
                             continue;
                         }
                     }
-                    frame.world.touch();
+                    self.edited(frame);
                     frame.model = self.settings.model.build();
                     frame.notice = None;
                     frame.energy_reset = frame.world.kinetic_energy();
@@ -515,6 +518,9 @@ impl Engine {
     #[allow(clippy::unused_self)] // one of the engine's steps, called as one
     fn edited(&self, frame: &mut Frame) {
         frame.world.touch();
+        if let Some(p) = frame.probe.as_mut() {
+            p.forget();
+        }
         frame.energy_reset = frame.world.kinetic_energy();
     }
 

@@ -80,6 +80,11 @@ pub struct Snapshot {
     /// How many pool lanes the widest section of this frame kept busy, of
     /// how many threads, and what held it there (`None` off the pool).
     pub pool_busy: Option<Busy>,
+    /// The running scene's parallelism, work over span on unlimited lanes,
+    /// measured every few seconds on one step under `pool` (docs/threading.md,
+    /// "Parallelism on the threads panel"); `None` in the other modes, for
+    /// a model on one lane, in a headless engine, and until first measured.
+    pub parallelism: Option<f64>,
 }
 
 impl Snapshot {
@@ -114,6 +119,7 @@ impl Snapshot {
             threads_for: None,
             notice: None,
             pool_busy: None,
+            parallelism: None,
         };
         s.report_threads();
         let serial = crate::physics::Serial;

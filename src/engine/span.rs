@@ -61,6 +61,15 @@ impl WorkSpan {
     }
 }
 
+/// Jobs one after another: their work and spans add.
+impl std::ops::AddAssign for WorkSpan {
+    fn add_assign(&mut self, o: WorkSpan) {
+        self.work += o.work;
+        self.span += o.span;
+        self.span_inf += o.span_inf;
+    }
+}
+
 /// Nanoseconds the sections of a job took: their work, their makespans on
 /// the lanes they got, and their longest blocks.
 #[derive(Clone, Copy, Debug, Default)]

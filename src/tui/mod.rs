@@ -17,6 +17,7 @@ mod latch;
 mod msg;
 pub mod output;
 mod pacing;
+pub mod parallelism;
 mod present;
 pub mod projection;
 mod quit;

@@ -6,6 +6,7 @@
 //! and a sparkline; the threads' figures in columns; and only when even those
 //! rows run out, the numbered threads (`pool-0`…) as a grid of cells shaded
 //! by load, as btop shows cores, with a legend. No thread is ever left out.
+use super::parallelism::{parallelism_text, pool_rows};
 use super::theme::Palette;
 use crate::cpu::history;
 use crate::cpu::{CpuReport, ThreadLoad, ThreadRole, order_key};
@@ -33,10 +34,19 @@ pub struct Threads<'a> {
     pub pool: Option<String>,
 }
 
-/// The pool line of a frame a pool ran ([`pool_line`]), from what ran.
+/// The pool line of a frame a pool ran ([`pool_line`]), from what ran,
+/// with the scene's measured parallelism once there is one (none for a
+/// model on one lane: the line says it is serial).
 pub fn pool_line_of(snap: &crate::engine::Snapshot) -> Option<String> {
     let serial = snap.one_lane.then(|| snap.model_ran());
-    snap.pool_busy.map(|b| pool_line(&b, snap.count, serial))
+    let parallelism = snap.parallelism.filter(|_| serial.is_none());
+    snap.pool_busy.map(|b| {
+        let line = pool_line(&b, snap.count, serial);
+        match parallelism {
+            Some(p) => line + &parallelism_text(p),
+            None => line,
+        }
+    })
 }
 
 /// How many pool threads the scene keeps busy, and why no more, e.g.
@@ -476,9 +486,11 @@ impl Widget for Threads<'_> {
             Layout::Grid => self.compact_lines(w, h),
         };
         // The pool's line above the process and other-procs totals, where a row is spare.
-        if let Some(p) = self.pool.clone().filter(|_| h > lines.len()) {
+        if let Some(p) = self.pool.as_deref().filter(|_| h > lines.len()) {
             let at = lines.len().saturating_sub(2);
-            lines.insert(at, Line::from(Span::styled(p, self.palette.label())));
+            for (i, row) in pool_rows(p, w, h - lines.len()).into_iter().enumerate() {
+                lines.insert(at + i, Line::from(Span::styled(row, self.palette.label())));
+            }
         }
         Paragraph::new(lines).render(inner, buf);
     }

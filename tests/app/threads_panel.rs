@@ -241,3 +241,91 @@ fn the_pool_line_says_a_serial_model_keeps_one_thread_busy() {
         assert_eq!(line.as_deref(), Some(want), "{model}");
     }
 }
+
+/// The pool line with the parallelism the engine measured: whole where it
+/// fits, without ` (work/span)` where not, and the figure on a row of its
+/// own when even that is too wide; never past the panel's edge at 80x24.
+#[test]
+fn the_pool_line_gives_the_parallelism_within_the_panel() {
+    use ballpit::physics::ModelKind;
+    use ballpit::physics::exec::{Bound, Busy};
+    let mut snap =
+        ballpit::engine::Engine::new(ballpit::physics::World::new(1.0, Vec::new()), settings(2))
+            .unwrap()
+            .snapshot()
+            .clone();
+    let busy = |busy, threads, bound| Busy {
+        busy,
+        threads,
+        bound,
+    };
+    snap.pool_busy = Some(busy(2, 2, Bound::Threads));
+    snap.parallelism = Some(38.4);
+    let line = threads::pool_line_of(&snap).unwrap();
+    assert_eq!(line, "pool: 2 of 2 busy · parallelism 38 (work/span)");
+    snap.parallelism = Some(1.46);
+    assert_eq!(
+        threads::pool_line_of(&snap).unwrap(),
+        "pool: 2 of 2 busy · parallelism 1.5 (work/span)"
+    );
+    // A model on one lane: the line says so, and gives no figure.
+    snap.one_lane = true;
+    snap.settings.model = ModelKind::Exact;
+    assert_eq!(
+        threads::pool_line_of(&snap).unwrap(),
+        "pool: 1 of 2 busy — exact is serial"
+    );
+    snap.one_lane = false;
+    snap.settings.model = ModelKind::Swept;
+    snap.parallelism = Some(38.4);
+    // (At 80x24 a pool of 64 has no spare row for the pool line at all.)
+    for (w, h, pool) in [
+        (80u16, 24u16, 2usize),
+        (120, 40, 2),
+        (120, 40, 64),
+        (200, 60, 2),
+    ] {
+        {
+            let r = report(pool);
+            // Two of two: nothing to explain; two of 64: one a core.
+            let bound = if pool == 2 {
+                Bound::Threads
+            } else {
+                Bound::Cores
+            };
+            snap.pool_busy = Some(busy(2, pool, bound));
+            let area = app::areas(Rect::new(0, 0, w, h), &r).unwrap().threads;
+            let mut t = Terminal::new(TestBackend::new(area.width, area.height)).unwrap();
+            t.draw(|f| {
+                f.render_widget(
+                    Threads {
+                        report: &r,
+                        palette: Palette::Mono,
+                        by_cpu: false,
+                        pool: threads::pool_line_of(&snap),
+                    },
+                    f.area(),
+                );
+            })
+            .unwrap();
+            let text = rows(&t);
+            let all = text.join("\n");
+            let inner = usize::from(area.width) - 2;
+            let full = threads::pool_line_of(&snap).unwrap();
+            let at = text.iter().position(|l| l.contains("pool: 2 of")).unwrap();
+            let shown = text[at].trim_matches('│').trim_end();
+            if full.chars().count() <= inner {
+                assert_eq!(shown, full, "{w}x{h} pool {pool}\n{all}");
+            } else {
+                // Cut where it must be, and the figure still shown.
+                assert!(shown.chars().count() < full.chars().count(), "{all}");
+                assert!(all.contains("parallelism 38"), "{w}x{h} pool {pool}\n{all}");
+            }
+            assert!(
+                text.iter()
+                    .all(|l| l.chars().count() == usize::from(area.width))
+            );
+            insta::assert_snapshot!(format!("parallelism_{w}x{h}_pool_{pool}"), t.backend());
+        }
+    }
+}

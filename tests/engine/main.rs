@@ -16,6 +16,7 @@ mod grow;
 mod headless;
 mod hostile_scenes;
 mod memory_limit;
+mod parallelism;
 mod pool_idle;
 mod readme;
 mod scaling;

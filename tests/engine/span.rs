@@ -94,3 +94,43 @@ fn the_exact_models_events_are_one_chain() {
         w.max_overlap_rel()
     );
 }
+
+/// `bench --threading pool`: the same steps replayed on the pool's lanes
+/// give `work_seconds ≥ span_seconds > 0` and a parallelism at least their
+/// ratio (the replay ending in the timed run's bits, or the run fails); the
+/// other modes leave the three null (docs/design.md, bench JSON).
+#[test]
+fn bench_gives_work_and_span_for_pool_runs_and_null_for_the_others() {
+    use crate::common::json;
+    let run = |threading: &str, threads: &str| {
+        json::bench(&[
+            "--threading",
+            threading,
+            "--threads",
+            threads,
+            "--steps",
+            "12",
+            "--count",
+            "12000",
+            "--radius",
+            "0.006",
+        ])
+    };
+    for threads in ["2", "64"] {
+        let v = run("pool", threads);
+        let f = |k: &str| v[k].as_f64().unwrap_or_else(|| panic!("{k}: {v}"));
+        let (work, span, par) = (f("work_seconds"), f("span_seconds"), f("parallelism"));
+        assert!(span > 0.0 && work >= span, "{threads}: {v}");
+        assert!(par >= work / span - 1e-9, "{threads}: {v}");
+        // 12 000 spheres: some sections spread over the lanes.
+        assert!(par > 1.2, "{threads}: {v}");
+        assert_eq!(v["escaped"], 0, "{v}");
+        assert!(f("energy_drift_rel") < 1e-6, "{v}");
+    }
+    for threading in ["off", "worker", "split"] {
+        let v = run(threading, "2");
+        for k in ["work_seconds", "span_seconds", "parallelism"] {
+            assert!(v[k].is_null(), "{threading} {k}: {v}");
+        }
+    }
+}
