@@ -88,13 +88,20 @@ fn cradle(count: usize, radius: f64, speed: f64, size: f64) -> Result<World, Bad
     }
     let c = 0.5 * size;
     let start = c - 0.5 * need + radius;
+    let mut last = f64::NEG_INFINITY;
     let spheres = (0..count)
         .map(|i| {
-            let x = if i == 0 {
+            let mut x = if i == 0 {
                 start
             } else {
                 start + gap + 2.0 * radius * i as f64
             };
+            // Touching, never overlapping: rounding may put a sphere a bit
+            // inside the last, which `exact` refuses.
+            while x - last < 2.0 * radius {
+                x = x.next_up();
+            }
+            last = x;
             let v = if i == 0 { speed } else { 0.0 };
             Sphere::new(DVec3::new(x, c, c), DVec3::new(v, 0.0, 0.0), radius)
         })

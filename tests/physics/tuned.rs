@@ -38,7 +38,7 @@ proptest! {
 
     /// Random gases and radius-spread scenes over packings 0.005–0.2 and
     /// speeds 0.1–30: the parts chosen keep the added pairs per sphere
-    /// under 1.5 [`ADDED_PAIRS`] (the estimate samples; 200 cases measured
+    /// under 1.5 [`ADDED_PAIRS`] and a count's scatter (the estimate samples; 200 cases measured
     /// at most 1.18), and one part fewer would add over 0.4 of it (at
     /// least 0.57 measured): the cut is not far finer than it must be.
     /// (Scenes placed on a lattice are not held: their gaps are all alike,
@@ -66,7 +66,12 @@ proptest! {
         .map_err(|e| TestCaseError::fail(format!("{e}")))?;
         let (k, after) = step(&w);
         let (at, fewer) = (added_pairs(&w, k), (k > 1).then(|| added_pairs(&w, k - 1)));
-        prop_assert!(at <= 1.5 * ADDED_PAIRS, "{k} parts add {at} pairs a sphere");
+        // The added pairs of one scene are a count, so they scatter about
+        // the estimate's mean by about its square root (three of it here):
+        // a few hundred spheres scatter by a tenth of a pair a sphere.
+        let n = w.spheres.len() as f64;
+        let scatter = 3.0 * (ADDED_PAIRS * n).sqrt() / n;
+        prop_assert!(at <= 1.5 * ADDED_PAIRS + scatter, "{k} parts add {at} pairs a sphere");
         if let Some(fewer) = fewer {
             prop_assert!(fewer > 0.4 * ADDED_PAIRS, "{} parts add only {fewer}", k - 1);
         }
