@@ -10,16 +10,16 @@ use super::place::{copy_in_order, layer_starts, order_room, sort_layers};
 
 /// Staged keys per block of the deal; fixed, never the lane count.
 const DEAL_BLOCK: usize = 4096;
-/// The lane of a key in no lane's range (a ball too wide for the level).
-const NO_LANE: u32 = u32::MAX;
 
 /// One block's keys, dealt.
 #[derive(Default)]
 struct Block {
-    /// Where each lane's keys start in `picks`, then their end.
+    /// Where each lane's keys start in `picks`, then those in no lane's
+    /// range (balls too wide for the level: rare, and dealt to keep the
+    /// loops free of branches), then their end.
     starts: Vec<u32>,
-    /// (cell key, sphere index) of the keys in some lane's range, grouped
-    /// by lane, each group in id order.
+    /// (cell key, sphere index) of the keys, grouped by lane, each group
+    /// in id order.
     picks: Vec<(u32, u32)>,
     /// While dealing: each key's lane, and where each lane's next one goes.
     lane: Vec<u32>,
@@ -37,13 +37,15 @@ pub(super) struct Buckets {
 }
 
 /// The lane whose range `l * cells / lanes .. (l + 1) * cells / lanes`
-/// holds `key` (below `cells`): `((key + 1) lanes - 1) / cells`, computed
-/// as `((key + 1) lanes - 1/2) / cells` in floating point, which is exact
-/// (the quotient lies at least `1 / (2 cells)` from an integer, far above
-/// the rounding of numbers under 2^53) and much cheaper than a division.
+/// holds `key`, `lanes` for a key from `cells` on: `((key + 1) lanes - 1)
+/// / cells`, computed as `((key + 1) lanes - 1/2) / cells` in floating
+/// point, which is exact (the quotient lies at least `1 / (2 cells)` from
+/// an integer, far above the rounding of numbers under 2^53) and much
+/// cheaper than a division.
 #[inline]
 fn lane_of(key: u32, lanes: usize, inv_cells: f64) -> u32 {
-    ((f64::from(key + 1) * lanes as f64 - 0.5) * inv_cells) as u32
+    let l = ((f64::from(key) + 1.0) * lanes as f64 - 0.5) * inv_cells;
+    (l as u32).min(lanes as u32)
 }
 
 impl Buckets {
@@ -75,37 +77,29 @@ impl Buckets {
             } = &mut guard[0];
             let ids = b * DEAL_BLOCK..((b + 1) * DEAL_BLOCK).min(n);
             starts.clear();
-            starts.resize(lanes + 1, 0);
-            lane.clear();
+            starts.resize(lanes + 2, 0);
+            lane.resize(ids.len(), 0);
             let mut reach_max: f64 = 0.0;
-            for (key, r) in staged.keys_of(ids.clone()) {
-                let l = if (key as usize) < cells {
-                    lane_of(key, lanes, inv_cells)
-                } else {
-                    NO_LANE
-                };
-                lane.push(l);
-                if l != NO_LANE {
-                    starts[l as usize + 1] += 1;
-                }
+            for ((key, r), at) in staged.keys_of(ids.clone()).zip(lane.iter_mut()) {
+                let l = lane_of(key, lanes, inv_cells);
+                *at = l;
+                starts[l as usize + 1] += 1;
                 // Not `f64::max`: see `Level::fill_lanes`.
-                if l != NO_LANE && r > reach_max {
+                if (l as usize) < lanes && r > reach_max {
                     reach_max = r;
                 }
             }
-            for l in 0..lanes {
+            for l in 0..=lanes {
                 starts[l + 1] += starts[l];
             }
             next.clear();
-            next.extend_from_slice(&starts[..lanes]);
-            picks.resize(starts[lanes] as usize, (0, 0));
+            next.extend_from_slice(&starts[..=lanes]);
+            picks.resize(starts[lanes + 1] as usize, (0, 0));
             let dealt = staged.keys_of(ids.clone()).zip(lane.iter());
             for (((key, _), &l), i) in dealt.zip(ids.start as u32..) {
-                if l != NO_LANE {
-                    let at = &mut next[l as usize];
-                    picks[*at as usize] = (key, i);
-                    *at += 1;
-                }
+                let at = &mut next[l as usize];
+                picks[*at as usize] = (key, i);
+                *at += 1;
             }
             *reach = reach_max;
         });
@@ -114,11 +108,13 @@ impl Buckets {
         widest.fold(0.0, |m, b| m.max(b.reach))
     }
 
-    /// Lane `l`'s (cell key, sphere index) of the last deal, in id order.
-    pub(super) fn lane(&self, l: usize) -> impl DoubleEndedIterator<Item = (u32, u32)> + '_ {
-        self.blocks[..self.used].iter().flat_map(move |b| {
+    /// Lane `l`'s (cell key, sphere index) of the last deal, in id order,
+    /// a group a block (nested loops over them cost less than a flattened
+    /// iterator's checks).
+    pub(super) fn lane(&self, l: usize) -> impl DoubleEndedIterator<Item = &[(u32, u32)]> + '_ {
+        self.blocks[..self.used].iter().map(move |b| {
             let (from, to) = (b.starts[l] as usize, b.starts[l + 1] as usize);
-            b.picks[from..to].iter().copied()
+            &b.picks[from..to]
         })
     }
 
@@ -132,10 +128,12 @@ impl Buckets {
         order: &mut Vec<u32>,
     ) {
         order_room(order, region.len());
-        for (key, i) in self.lane(l).rev() {
-            let slot = &mut table[(key - lo) as usize];
-            *slot -= 1;
-            order[(*slot - base) as usize] = i;
+        for group in self.lane(l).rev() {
+            for &(key, i) in group.iter().rev() {
+                let slot = &mut table[(key - lo) as usize];
+                *slot -= 1;
+                order[(*slot - base) as usize] = i;
+            }
         }
         copy_in_order(staged, region, order);
     }
@@ -153,10 +151,12 @@ impl Buckets {
         scratch: &mut Vec<Entry>,
     ) {
         layer_starts(heads);
-        for (key, i) in self.lane(l) {
-            let head = &mut heads[(key - lo) as usize / layer];
-            region[*head as usize] = staged.entry(i as usize);
-            *head += 1;
+        for group in self.lane(l) {
+            for &(key, i) in group {
+                let head = &mut heads[(key - lo) as usize / layer];
+                region[*head as usize] = staged.entry(i as usize);
+                *head += 1;
+            }
         }
         sort_layers(lo, base, table, region, layer, heads, scratch);
     }
@@ -170,10 +170,12 @@ impl Buckets {
         table: &mut [u32],
         region: &mut [Entry],
     ) {
-        for (key, i) in self.lane(l).rev() {
-            let slot = &mut table[(key - lo) as usize];
-            *slot -= 1;
-            region[(*slot - base) as usize] = records[i as usize];
+        for group in self.lane(l).rev() {
+            for &(key, i) in group.iter().rev() {
+                let slot = &mut table[(key - lo) as usize];
+                *slot -= 1;
+                region[(*slot - base) as usize] = records[i as usize];
+            }
         }
     }
 }
@@ -211,7 +213,7 @@ mod tests {
     }
 
     #[test]
-    fn a_key_goes_to_the_lane_whose_range_holds_it() {
+    fn a_key_goes_to_the_lane_whose_range_holds_it_and_a_wide_one_past_them() {
         for (cells, lanes) in [
             (10, 4),
             (42_875, 7),
@@ -224,6 +226,13 @@ mod tests {
                 for key in [bound(l), bound(l + 1) - 1] {
                     assert_eq!(lane_of(key, lanes, inv), l as u32, "{cells} {lanes} {key}");
                 }
+            }
+            for key in [cells as u32, WIDE] {
+                assert_eq!(
+                    lane_of(key, lanes, inv),
+                    lanes as u32,
+                    "{cells} {lanes} {key}"
+                );
             }
         }
     }

@@ -223,26 +223,32 @@ impl Level {
                 0
             };
             heads.resize(layers_here, 0);
-            let mut tally = |key: u32| {
-                if layered {
-                    heads[(key - lo) as usize / layer] += 1;
-                } else {
-                    table[(key - lo) as usize] += 1;
-                }
-                count += 1;
-            };
             if dealt {
                 // The widest reach came with the deal.
-                buckets.lane(l).for_each(|(key, _)| tally(key));
+                for group in buckets.lane(l) {
+                    count += group.len() as u32;
+                    for &(key, _) in group {
+                        if layered {
+                            heads[(key - lo) as usize / layer] += 1;
+                        } else {
+                            table[(key - lo) as usize] += 1;
+                        }
+                    }
+                }
             } else {
                 for (key, reach) in staged.keys() {
                     if key >= lo && key < hi {
-                        tally(key);
+                        if layered {
+                            heads[(key - lo) as usize / layer] += 1;
+                        } else {
+                            table[(key - lo) as usize] += 1;
+                        }
                         // Not `f64::max`: its NaN handling makes a slow chain
                         // through every sphere, and reaches are never NaN here.
                         if reach > reach_max {
                             reach_max = reach;
                         }
+                        count += 1;
                     }
                 }
             }
