@@ -23,6 +23,8 @@ pub(super) struct Entry {
 pub(super) trait Source: Sync {
     /// Each sphere's (cell key, reach), in id order.
     fn keys(&self) -> impl DoubleEndedIterator<Item = (u32, f64)> + ExactSizeIterator;
+    /// The (cell key, reach) of spheres `ids` alone, as `keys` gives them.
+    fn keys_of(&self, ids: std::ops::Range<usize>) -> impl Iterator<Item = (u32, f64)>;
     /// Sphere `i`'s record.
     fn entry(&self, i: usize) -> Entry;
     /// The records themselves, when they lie in memory in id order.
@@ -33,6 +35,10 @@ impl Source for [Entry] {
     #[inline(always)]
     fn keys(&self) -> impl DoubleEndedIterator<Item = (u32, f64)> + ExactSizeIterator {
         self.iter().map(|e| (e.key, e.ball.reach))
+    }
+    #[inline(always)]
+    fn keys_of(&self, ids: std::ops::Range<usize>) -> impl Iterator<Item = (u32, f64)> {
+        self[ids].iter().map(|e| (e.key, e.ball.reach))
     }
     #[inline(always)]
     fn entry(&self, i: usize) -> Entry {

@@ -2,6 +2,8 @@
 //! of their ball's centre (a counting sort by cell key), the same-level
 //! pairs, and the searches around a point or along the faces of the box.
 use super::super::exec::{Exec, PerBlock, spans};
+use super::super::wide::wide_for;
+use super::buckets::Buckets;
 use super::entry::{Ball, Entry, Source};
 use super::place::{place_indirect, place_layered, running_sums};
 use glam::DVec3;
@@ -46,6 +48,8 @@ pub(super) struct Level {
     /// Per lane of `fill_lanes`, for a source without records: where each
     /// layer's records go next, and room for one layer's records.
     layers: PerBlock<(Vec<u32>, Vec<Entry>)>,
+    /// The staged keys dealt out to the lanes (the wide form of `fill_lanes`).
+    buckets: Buckets,
     /// Largest reach in this level.
     pub(super) reach_max: f64,
 }
@@ -191,6 +195,15 @@ impl Level {
         // which are counted here instead of the cells.
         let layered = staged.records().is_none();
         let layer = self.side * self.side;
+        // From `WIDE_LANES` lanes on, the keys are dealt to the lanes first
+        // (work O(N)); on fewer, each lane scanning them all costs less.
+        let dealt = wide_for(lanes);
+        if dealt {
+            self.reach_max = self
+                .reach_max
+                .max(self.buckets.deal(staged, lanes, cells, exec));
+        }
+        let buckets = &self.buckets;
         self.layers.ensure(lanes);
         let layers = &self.layers;
         exec.for_lanes(lanes, &|l| {
@@ -211,19 +224,33 @@ impl Level {
                 0
             };
             heads.resize(layers_here, 0);
-            for (key, reach) in staged.keys() {
-                if key >= lo && key < hi {
-                    if layered {
-                        heads[(key - lo) as usize / layer] += 1;
-                    } else {
-                        table[(key - lo) as usize] += 1;
+            if dealt {
+                // The widest reach came with the deal.
+                for group in buckets.lane(l) {
+                    count += group.len() as u32;
+                    for &(key, _) in group {
+                        if layered {
+                            heads[(key - lo) as usize / layer] += 1;
+                        } else {
+                            table[(key - lo) as usize] += 1;
+                        }
                     }
-                    // Not `f64::max`: its NaN handling makes a slow chain
-                    // through every sphere, and reaches are never NaN here.
-                    if reach > reach_max {
-                        reach_max = reach;
+                }
+            } else {
+                for (key, reach) in staged.keys() {
+                    if key >= lo && key < hi {
+                        if layered {
+                            heads[(key - lo) as usize / layer] += 1;
+                        } else {
+                            table[(key - lo) as usize] += 1;
+                        }
+                        // Not `f64::max`: its NaN handling makes a slow chain
+                        // through every sphere, and reaches are never NaN here.
+                        if reach > reach_max {
+                            reach_max = reach;
+                        }
+                        count += 1;
                     }
-                    count += 1;
                 }
             }
             *totals[l].lock() = (count, reach_max);
@@ -255,6 +282,12 @@ impl Level {
             if layered {
                 let mut guard = layers[l].lock();
                 let (heads, scratch) = &mut *guard;
+                if dealt {
+                    let lane = (staged, lo, offsets[l]);
+                    let (table, region) = (&mut table, &mut region);
+                    buckets.place_layered(l, lane, table, region, layer, heads, scratch);
+                    return;
+                }
                 let keys = lo..hi;
                 place_layered(
                     staged,
@@ -269,6 +302,16 @@ impl Level {
                 return;
             }
             running_sums(&mut table, offsets[l]);
+            if dealt {
+                if let Some(records) = records {
+                    let lane = (records, lo, offsets[l]);
+                    buckets.place_records(l, lane, &mut table, &mut region);
+                } else {
+                    let (lane, order) = ((staged, lo, offsets[l]), &mut orders[l].lock());
+                    buckets.place_indirect(l, lane, &mut table, &mut region, order);
+                }
+                return;
+            }
             if let Some(records) = records {
                 for s in records.iter().rev() {
                     if s.key >= lo && s.key < hi {
@@ -456,12 +499,12 @@ fn scan(a: &Ball, ia: u32, entries: &[Entry], f: &mut impl FnMut(u32, u32)) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::physics::exec::Serial;
 
     /// `n` records with keys of real cells of `level`, from a fixed LCG.
-    fn records(level: &Level, n: usize) -> Vec<Entry> {
+    pub(in super::super) fn records(level: &Level, n: usize) -> Vec<Entry> {
         let mut x = 0x9e37_79b9_7f4a_7c15_u64;
         let mut unit = || {
             x = x.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
@@ -496,11 +539,14 @@ mod tests {
     }
 
     /// A source without records, as the keyed first level is.
-    struct KeysOnly(Vec<Entry>);
+    pub(in super::super) struct KeysOnly(pub(in super::super) Vec<Entry>);
 
     impl Source for KeysOnly {
         fn keys(&self) -> impl DoubleEndedIterator<Item = (u32, f64)> + ExactSizeIterator {
             self.0.iter().map(|e| (e.key, e.ball.reach))
+        }
+        fn keys_of(&self, ids: std::ops::Range<usize>) -> impl Iterator<Item = (u32, f64)> {
+            self.0[ids].iter().map(|e| (e.key, e.ball.reach))
         }
         fn entry(&self, i: usize) -> Entry {
             self.0[i]

@@ -7,6 +7,7 @@
 //! the finer levels by querying their cells over its own reach, so radii or
 //! speeds spread over orders of magnitude stay about linear in cost. Tiny
 //! scenes use all pairs.
+mod buckets;
 mod entry;
 mod level;
 mod pairs;
@@ -74,6 +75,10 @@ impl<T: Sync, B: Fn(&T) -> (DVec3, f64) + Sync> Source for Keyed<'_, T, B> {
     #[inline(always)]
     fn keys(&self) -> impl DoubleEndedIterator<Item = (u32, f64)> + ExactSizeIterator {
         self.keys.iter().map(|&k| (k, 0.0))
+    }
+    #[inline(always)]
+    fn keys_of(&self, ids: std::ops::Range<usize>) -> impl Iterator<Item = (u32, f64)> {
+        self.keys[ids].iter().map(|&k| (k, 0.0))
     }
     #[inline(always)]
     fn entry(&self, i: usize) -> Entry {

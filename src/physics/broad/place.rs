@@ -46,13 +46,7 @@ pub(super) fn place_indirect<S: Source + ?Sized>(
     order: &mut Vec<u32>,
 ) {
     let (lo, hi) = (keys.start, keys.end);
-    order.truncate(region.len());
-    if order.capacity() < region.len() {
-        // Exact, a sixty-fourth over: `resize` would double it.
-        let more = region.len() + region.len() / 64 - order.len();
-        order.reserve_exact(more);
-    }
-    order.resize(region.len(), 0);
+    order_room(order, region.len());
     for (i, (key, _)) in staged.keys().enumerate().rev() {
         if key >= lo && key < hi {
             let slot = &mut table[(key - lo) as usize];
@@ -60,6 +54,23 @@ pub(super) fn place_indirect<S: Source + ?Sized>(
             order[(*slot - base) as usize] = i as u32;
         }
     }
+    copy_in_order(staged, region, order);
+}
+
+/// Room for `n` places in `order`, exact and a sixty-fourth over:
+/// `resize` would double it.
+#[inline]
+pub(super) fn order_room(order: &mut Vec<u32>, n: usize) {
+    order.truncate(n);
+    if order.capacity() < n {
+        order.reserve_exact(n + n / 64 - order.len());
+    }
+    order.resize(n, 0);
+}
+
+/// The records `order` names, copied into `region` in its order.
+#[inline]
+pub(super) fn copy_in_order<S: Source + ?Sized>(staged: &S, region: &mut [Entry], order: &[u32]) {
     for (e, &i) in region.iter_mut().zip(order.iter()) {
         *e = staged.entry(i as usize);
     }
@@ -87,11 +98,7 @@ pub(super) fn place_layered<S: Source + ?Sized>(
     scratch: &mut Vec<Entry>,
 ) {
     let (lo, hi) = (keys.start, keys.end);
-    // Each layer's count to where it starts in the region.
-    let mut start = 0;
-    for h in heads.iter_mut() {
-        (*h, start) = (start, start + *h);
-    }
+    layer_starts(heads);
     for (i, (key, _)) in staged.keys().enumerate() {
         if key >= lo && key < hi {
             let head = &mut heads[(key - lo) as usize / layer];
@@ -99,9 +106,30 @@ pub(super) fn place_layered<S: Source + ?Sized>(
             *head += 1;
         }
     }
-    // Each layer now holds its records in id order, and ends where its
-    // head stopped; the counting sort of each, from its copy, keeps that
-    // order within a cell.
+    sort_layers(lo, base, table, region, layer, heads, scratch);
+}
+
+/// Each layer's count in `heads` to where it starts in the region.
+#[inline]
+pub(super) fn layer_starts(heads: &mut [u32]) {
+    let mut start = 0;
+    for h in heads.iter_mut() {
+        (*h, start) = (start, start + *h);
+    }
+}
+
+/// The second half of [`place_layered`]: each layer of `region` holds its
+/// records in id order and ends where its head stopped; the counting sort
+/// of each, from its copy, keeps that order within a cell.
+pub(super) fn sort_layers(
+    lo: u32,
+    base: u32,
+    table: &mut [u32],
+    region: &mut [Entry],
+    layer: usize,
+    heads: &[u32],
+    scratch: &mut Vec<Entry>,
+) {
     let mut from = 0;
     for (k, (cells, &to)) in table.chunks_mut(layer).zip(heads.iter()).enumerate() {
         let first = lo + (k * layer) as u32;
