@@ -130,9 +130,12 @@ impl SpanExec {
         let t0 = thread_cpu_ns();
         job();
         let t = *self.tally.lock();
+        // At least its sections' work: the readings' cost, taken off as
+        // measured at start, may take off more than they cost on a tiny job.
         let work = thread_cpu_ns()
             .saturating_sub(t0)
-            .saturating_sub((t.reads + 1) * self.read_ns);
+            .saturating_sub((t.reads + 1) * self.read_ns)
+            .max(t.work);
         let serial = work.saturating_sub(t.work);
         let s = |ns: u64| ns as f64 * 1e-9;
         WorkSpan {
