@@ -66,7 +66,7 @@ impl Palette {
             Palette::True
         } else if term.contains("256color") {
             Palette::C256
-        } else if super::caps::monochrome(&term) {
+        } else if crate::tui::term::caps::monochrome(&term) {
             Palette::Mono
         } else {
             Palette::C16
