@@ -51,11 +51,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             Ok(emit(table.as_bytes())?)
         }
         Some(Command::Scaling(args)) => {
-            if !(args.dt.is_finite() && args.dt > 0.0) {
-                return Err(
-                    BadInput(format!("--dt must be a finite number > 0, got {}", args.dt)).into(),
-                );
-            }
+            ballpit::cli::check_dt(args.dt)?;
             let plan = args.plan();
             let world = scene::build_world_for(&args.spec(), Some(plan.model))?;
             fits(world.spheres.len(), Some(plan.model))?;

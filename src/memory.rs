@@ -6,7 +6,7 @@ use crate::physics::ModelKind;
 /// Peak bytes a sphere costs while a model steps headless (`bench`), with a
 /// quarter for margin (peak RSS at a million spheres less the empty process,
 /// the largest of packing 0.005, 0.1 and the dense preset: for `exact` 185,
-/// 184 and 248 B; docs/benchmarks.md has the runs).
+/// 184 and 248 B; docs/figures.md#memory has the runs).
 pub fn sphere_bytes(model: ModelKind) -> u64 {
     match model {
         ModelKind::Discrete => 243,

@@ -106,6 +106,29 @@ pub(super) fn bench_after_help() -> String {
     s
 }
 
+/// `tradeoff --help`'s long description, its models named from the list it
+/// runs ([`ModelKind::ALL`](crate::physics::ModelKind::ALL)), so a model
+/// added there is named here.
+pub(super) fn tradeoff_long_about() -> String {
+    let names: Vec<&str> = crate::physics::ModelKind::ALL
+        .iter()
+        .map(|m| m.name())
+        .collect();
+    let list = match names.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+        _ => names.join(""),
+    };
+    format!(
+        "Measure speed against accuracy for every model over a ladder of dt.\n\n\
+         Runs {list} (auto at tolerance 0, naming the model it chose) on one thread for \
+         dt = 1/15 s down to 1/1920 s (halving), each for 2 simulated seconds, and measures \
+         each run against a reference run of the same scene: cost (wall seconds per \
+         simulated second), worst energy error, deepest overlap, escapes, collisions \
+         missed, and the position error at a short horizon. Prints a markdown table; the \
+         table names its reference."
+    )
+}
+
 pub(super) fn tradeoff_after_help() -> String {
     format!(
         "With --out DIR it also writes DIR/tradeoff.csv (columns: {}) and DIR/tradeoff.svg \

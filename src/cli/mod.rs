@@ -20,6 +20,7 @@ use clap::parser::ValueSource;
 use clap::{ArgMatches, Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 use help::{
     bench_after_help, scaling_after_help, scene_long_help, threads_help, tradeoff_after_help,
+    tradeoff_long_about,
 };
 use std::ffi::OsString;
 use std::path::PathBuf;
@@ -60,13 +61,7 @@ pub enum Command {
     /// Measure speed against accuracy for every model over a ladder of dt
     #[command(
         allow_negative_numbers = true,
-        long_about = "Measure speed against accuracy for every model over a ladder of dt.\n\n\
-                      Runs discrete, swept and exact on one thread for dt = 1/15 s down to \
-                      1/1920 s (halving), each for 2 simulated seconds, and measures each run \
-                      against a reference run of the same scene: cost (wall seconds per \
-                      simulated second), worst energy error, deepest overlap, escapes, \
-                      collisions missed, and the position error at a short horizon. Prints a \
-                      markdown table; the table names its reference.",
+        long_about = tradeoff_long_about(),
         after_help = tradeoff_after_help()
     )]
     Tradeoff(TradeoffArgs),
@@ -328,6 +323,16 @@ fn flags_given(cmd: &clap::Command, m: &ArgMatches) -> Vec<String> {
         .collect()
 }
 
+/// `--dt` as every command takes it: a finite step above 0 (the parser
+/// reads numbers and fractions; this is the one check of their range).
+pub fn check_dt(dt: f64) -> Result<f64, BadInput> {
+    if dt.is_finite() && dt > 0.0 {
+        Ok(dt)
+    } else {
+        bad!("--dt must be a finite number > 0, got {dt}")
+    }
+}
+
 impl SceneArgs {
     pub fn spec(&self) -> SceneSpec {
         SceneSpec {
@@ -355,9 +360,7 @@ impl RunArgs {
     }
 
     pub fn settings(&self) -> Result<Settings, BadInput> {
-        if !(self.dt.is_finite() && self.dt > 0.0) {
-            return bad!("--dt must be a finite number > 0, got {}", self.dt);
-        }
+        check_dt(self.dt)?;
         let threads = self.threads.unwrap_or_else(default_threads);
         let mut model: ModelKind = self.model.into();
         if let Some(t) = self.tolerance {
@@ -392,5 +395,22 @@ mod tests {
     #[test]
     fn the_command_is_well_formed() {
         Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn tradeoff_help_names_every_model_it_runs() {
+        let mut cmd = Cli::command();
+        let help = cmd
+            .find_subcommand_mut("tradeoff")
+            .expect("a tradeoff subcommand")
+            .render_long_help()
+            .to_string();
+        assert!(
+            help.contains("Runs discrete, swept, exact and auto (auto at tolerance 0"),
+            "{help}"
+        );
+        for m in ModelKind::ALL {
+            assert!(help.contains(m.name()), "{m} missing from: {help}");
+        }
     }
 }

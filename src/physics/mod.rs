@@ -19,6 +19,7 @@ pub mod reference;
 pub mod relax;
 pub mod sphere;
 pub mod swept;
+pub(crate) mod wide;
 pub(crate) mod world;
 
 pub use exec::{Exec, Serial};

@@ -8,11 +8,13 @@
 //!
 //! Per configuration: steps/s (median of the rounds), speed-up over `off`,
 //! efficiency (speed-up per processor it can use), physics CPU seconds, and
-//! for the pool the serial fraction two ways: measured, from the pool's own
-//! account of the time a step spends outside its parallel sections (over
-//! the `off` run's time: the share of one thread's work that did not
-//! spread), and the Karp–Flatt fraction of its speed-up. One Amdahl fit of
-//! the pool's speed-ups then predicts 16, 64 and 128 cores.
+//! CPU seconds over `off`'s (what the threading itself costs), and for the
+//! pool the serial fraction two ways: measured, from the pool's own account
+//! of the time a step spends outside its parallel sections (over that run's
+//! own physics time, so in [0, 1] whatever the overhead), and the
+//! Karp–Flatt fraction of its speed-up (none where there is no speed-up).
+//! One Amdahl fit of the pool's speed-ups then predicts 16, 64 and 128
+//! cores. A scene whose sections never get a second lane is said so.
 mod fit;
 mod report;
 
@@ -97,9 +99,15 @@ pub struct Row {
     pub speedup: f64,
     pub efficiency: f64,
     pub physics_cpu_seconds: f64,
+    /// `physics_cpu_seconds` less `off`'s: the CPU the threading itself
+    /// costs (hand-offs, waking, spinning; negative only by noise).
+    pub cpu_over_off: f64,
     /// Pool on more than one processor: the serial part of its time over
-    /// the `off` run's time (`None` elsewhere).
+    /// its own physics time, in [0, 1] (`None` elsewhere).
     pub serial_measured: Option<f64>,
+    /// Pool on more than one processor with a speed-up from 1 to linear:
+    /// the Karp–Flatt fraction, in [0, 1]. `None` below a speed-up of 1
+    /// ("no speed-up") or above linear, where no serial fraction gives it.
     pub karp_flatt: Option<f64>,
     /// The run ended in the same bits as `off` (every round).
     pub same_bits: bool,
@@ -118,6 +126,9 @@ pub struct Sweep {
     pub fitted: Option<f64>,
     /// The pool rows' measured serial fractions, their median.
     pub measured: Option<f64>,
+    /// Why no configuration can beat `off` here, when a probe of a pool
+    /// found no section with a second lane.
+    pub nothing_to_share: Option<String>,
 }
 
 impl Sweep {
@@ -154,6 +165,7 @@ pub fn measure(
     let load_start = bench::load_average();
     progress(0, "probe");
     let steps = probe_steps(world, plan)?;
+    let nothing_to_share = probe_sharing(world, plan)?;
     let configs = configs(plan.top);
     // Round 0 runs `off` first: its end is what every run must end in.
     let mut reference: Option<World> = None;
@@ -203,13 +215,14 @@ pub fn measure(
         rows,
         fitted: fit::fit(&points),
         measured,
+        nothing_to_share,
     })
 }
 
 /// The rows of `runs` (by configuration, one per round), against `off`'s.
 fn rows(configs: &[Config], runs: &[Vec<Run>], cores: usize) -> Vec<Row> {
     let off = |f: &dyn Fn(&Run) -> f64| median(runs[0].iter().map(f).collect()).unwrap_or(0.0);
-    let (off_rate, off_wall) = (off(&|r| r.steps_per_second), off(&|r| r.wall));
+    let (off_rate, off_cpu) = (off(&|r| r.steps_per_second), off(&|r| r.cpu));
     configs
         .iter()
         .zip(runs)
@@ -220,7 +233,7 @@ fn rows(configs: &[Config], runs: &[Vec<Run>], cores: usize) -> Vec<Row> {
             let speedup = if off_rate > 0.0 { rate / off_rate } else { 0.0 };
             let serial = median(
                 runs.iter()
-                    .filter_map(|r| r.parallel.map(|p| (r.wall - p).max(0.0)))
+                    .filter_map(|r| serial_fraction(r.wall, r.parallel?))
                     .collect(),
             );
             let lo = runs
@@ -228,6 +241,7 @@ fn rows(configs: &[Config], runs: &[Vec<Run>], cores: usize) -> Vec<Row> {
                 .map(|r| r.steps_per_second)
                 .fold(f64::INFINITY, f64::min);
             let hi = runs.iter().map(|r| r.steps_per_second).fold(0.0, f64::max);
+            let cpu = of(&|r| r.cpu);
             Row {
                 config,
                 processors,
@@ -235,17 +249,52 @@ fn rows(configs: &[Config], runs: &[Vec<Run>], cores: usize) -> Vec<Row> {
                 steps_per_second_range: (lo, hi),
                 speedup,
                 efficiency: speedup / processors as f64,
-                physics_cpu_seconds: of(&|r| r.cpu),
-                serial_measured: serial
-                    .filter(|_| processors > 1 && off_wall > 0.0)
-                    .map(|s| s / off_wall),
+                physics_cpu_seconds: cpu,
+                cpu_over_off: cpu - off_cpu,
+                serial_measured: serial.filter(|_| processors > 1),
                 karp_flatt: (config.threading == Threading::Pool)
                     .then(|| fit::karp_flatt(speedup, processors as f64))
-                    .flatten(),
+                    .flatten()
+                    .filter(|f| (0.0..=1.0).contains(f)),
                 same_bits: runs.iter().all(|r| r.same_bits),
             }
         })
         .collect()
+}
+
+/// The serial share of one pool run: its time outside sections of more
+/// than one lane over its own physics time. Over `off`'s time instead it
+/// would count the pool's overhead as serial work and exceed 1 on a pool
+/// slower than `off`; over its own it is in [0, 1] by construction.
+fn serial_fraction(wall: f64, parallel: f64) -> Option<f64> {
+    (wall > 0.0).then(|| ((wall - parallel) / wall).clamp(0.0, 1.0))
+}
+
+/// A few steps of a pool of at least 2 threads: if no section ran on more
+/// than one lane, nothing in this scene can spread and the sweep says why.
+fn probe_sharing(world: &World, plan: &Plan) -> anyhow::Result<Option<String>> {
+    let pool = Config {
+        threading: Threading::Pool,
+        threads: plan.top.max(2),
+    };
+    let probe = 4;
+    let (report, _) = bench::run(world.clone(), &settings(plan, pool, probe), probe)?;
+    if report.parallel_seconds.is_some_and(|p| p > 0.0) {
+        return Ok(None);
+    }
+    let n = world.spheres.len();
+    let why = if plan.cores < 2 {
+        "this machine has one core".to_string()
+    } else {
+        format!(
+            "no section of a {} step on {n} sphere{} got a second lane (too few spheres for the lane rule, or a model that runs on one thread)",
+            plan.model,
+            if n == 1 { "" } else { "s" }
+        )
+    };
+    Ok(Some(format!(
+        "Nothing to share: {why}, so no mode below can beat off; they show only what their hand-offs cost."
+    )))
 }
 
 /// Steps that make an `off` run take about `plan.seconds`, from a short
@@ -301,6 +350,15 @@ fn median(mut v: Vec<f64>) -> Option<f64> {
 /// A directory that cannot be made or written, or threads the system
 /// refuses: bad input.
 pub fn run(world: &World, plan: &Plan, out: Option<&Path>) -> anyhow::Result<String> {
+    if world.spheres.is_empty() {
+        // An empty scene's steps are all hand-off: its "speed-ups" would be
+        // of nothing (9 M steps/s for `off`), so it is refused, not timed.
+        return Err(crate::error::BadInput(format!(
+            "scaling needs spheres to time: --count must be 1 to {} (the scene has 0)",
+            crate::scene::MAX_COUNT
+        ))
+        .into());
+    }
     if let Some(dir) = out {
         // Before the minute of measuring, not after: a bad path is bad input.
         std::fs::create_dir_all(dir).map_err(|e| {
@@ -339,6 +397,54 @@ mod tests {
         assert_eq!(configs(2)[0].threading, Threading::Off);
         assert_eq!(configs(2)[2].processors(1), 1);
         assert_eq!(configs(2).last().map(|c| c.processors(2)), Some(2));
+    }
+
+    fn run(wall: f64, cpu: f64, parallel: Option<f64>) -> Run {
+        Run {
+            steps_per_second: 100.0 / wall,
+            wall,
+            cpu,
+            parallel,
+            same_bits: true,
+        }
+    }
+
+    #[test]
+    fn a_pool_slower_than_off_has_a_serial_fraction_within_0_and_1() {
+        let configs = configs(2);
+        // off 1 s; a pool of 2 at 1.5 s, 0.2 s of it in parallel sections:
+        // 1.3 s serial, which over off's 1 s would read as 1.3.
+        let runs: Vec<Vec<Run>> = configs
+            .iter()
+            .map(|c| match (c.threading, c.threads) {
+                (Threading::Pool, 2) => vec![run(1.5, 2.1, Some(0.2))],
+                (Threading::Pool, t) => vec![run(1.0, 1.0, Some(if t > 1 { 0.9 } else { 0.0 }))],
+                _ => vec![run(1.0, 1.0, None)],
+            })
+            .collect();
+        let rows = rows(&configs, &runs, 2);
+        let pool2 = rows
+            .iter()
+            .find(|r| r.config.threading == Threading::Pool && r.config.threads == 2)
+            .unwrap();
+        let f = pool2.serial_measured.unwrap();
+        assert!((f - 1.3 / 1.5).abs() < 1e-12, "{f}");
+        assert!((pool2.speedup - 1.0 / 1.5).abs() < 1e-12);
+        assert_eq!(pool2.karp_flatt, None, "no speed-up, no fraction");
+        assert!((pool2.cpu_over_off - 1.1).abs() < 1e-12);
+        // A pool at off's own speed on 2 processors: Karp–Flatt exactly 1.
+        let pool4 = rows.last().unwrap();
+        assert_eq!(pool4.karp_flatt, Some(1.0));
+        assert!((pool4.serial_measured.unwrap() - 0.1).abs() < 1e-12);
+        // One processor: no measured fraction, whatever the clock says.
+        assert_eq!(rows[3].serial_measured, None);
+        for r in &rows {
+            for f in [r.serial_measured, r.karp_flatt].into_iter().flatten() {
+                assert!((0.0..=1.0).contains(&f), "{r:?}");
+            }
+        }
+        assert_eq!(serial_fraction(0.0, 0.0), None);
+        assert_eq!(serial_fraction(1.0, 1.2), Some(0.0), "clock skew clamps");
     }
 
     #[test]

@@ -10,6 +10,33 @@ fn opt(x: Option<f64>, digits: usize) -> String {
     x.map_or_else(|| "—".to_string(), |v| format!("{v:.digits$}"))
 }
 
+/// The Karp–Flatt cell: the fraction, or why a pool on more than one
+/// processor has none (a speed-up below 1, or above linear).
+fn karp_flatt_cell(r: &Row) -> String {
+    match r.karp_flatt {
+        None if r.config.threading == Threading::Pool && r.processors > 1 => if r.speedup < 1.0 {
+            "no speed-up"
+        } else {
+            "above linear"
+        }
+        .to_string(),
+        kf => opt(kf, 3),
+    }
+}
+
+/// `x` to three places, an empty sum's `-0` (or a rounding to it) as 0.
+fn three_places(x: f64) -> String {
+    let s = format!("{x:.3}");
+    if s.trim_start_matches('-')
+        .bytes()
+        .all(|b| b == b'0' || b == b'.')
+    {
+        "0".to_string()
+    } else {
+        s
+    }
+}
+
 /// The table, with the scene above it and the fit and its predictions below.
 #[must_use]
 pub fn markdown(s: &Sweep) -> String {
@@ -19,23 +46,27 @@ pub fn markdown(s: &Sweep) -> String {
         _ => String::new(),
     };
     let mut out = format!(
-        "Scaling of {} on {} spheres (packing {:.3}), dt {}, {} steps a run, {} rounds in alternation, {} cores{load}.\n\n",
+        "Scaling of {} on {} spheres (packing {}), dt {}, {} steps a run, {} rounds in alternation, {} cores{load}.\n\n",
         p.model,
         s.n,
-        s.packing,
+        three_places(s.packing),
         crate::tradeoff::dt_label(p.dt),
         s.steps,
         p.rounds,
         p.cores,
     );
+    if let Some(why) = &s.nothing_to_share {
+        out.push_str(why);
+        out.push_str("\n\n");
+    }
     out.push_str(
-        "| mode | threads | processors | steps/s | slowest–fastest | speed-up over off | efficiency | physics CPU s | serial fraction, measured | Karp–Flatt |\n\
-         |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| mode | threads | processors | steps/s | slowest–fastest | speed-up over off | efficiency | physics CPU s | CPU s over off | serial fraction, measured | Karp–Flatt |\n\
+         |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     for r in &s.rows {
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {:.1} | {:.1}–{:.1} | {:.2}× | {:.0} % | {:.2} | {} | {} |",
+            "| {} | {} | {} | {:.1} | {:.1}–{:.1} | {:.2}× | {:.0} % | {:.2} | {:+.2} | {} | {} |",
             r.config.threading,
             r.config.threads,
             r.processors,
@@ -45,8 +76,9 @@ pub fn markdown(s: &Sweep) -> String {
             r.speedup,
             100.0 * r.efficiency,
             r.physics_cpu_seconds,
+            r.cpu_over_off,
             opt(r.serial_measured, 3),
-            opt(r.karp_flatt, 3),
+            karp_flatt_cell(r),
         );
     }
     out.push('\n');
@@ -86,7 +118,7 @@ fn notes(s: &Sweep, out: &mut String) {
         Some(f) => {
             let _ = writeln!(
                 out,
-                "Amdahl fit of the pool's speed-ups up to the cores: serial fraction {f:.3} (the pool's own clock: {}).",
+                "Amdahl fit of the pool's speed-ups up to the cores: serial fraction {f:.3} (the pool's own clock, its time outside parallel sections: {}).",
                 opt(s.measured, 3)
             );
             let pred: Vec<String> = s
@@ -109,7 +141,7 @@ fn notes(s: &Sweep, out: &mut String) {
 
 /// The CSV's columns; `mode` is `predicted` on the rows of the fit's
 /// predictions (only `threads`, `processors` and `speedup` filled in).
-pub const CSV_COLUMNS: [&str; 13] = [
+pub const CSV_COLUMNS: [&str; 14] = [
     "mode",
     "threads",
     "processors",
@@ -120,6 +152,7 @@ pub const CSV_COLUMNS: [&str; 13] = [
     "speedup",
     "efficiency",
     "physics_cpu_seconds",
+    "cpu_seconds_over_off",
     "serial_measured",
     "karp_flatt",
     "same_bits",
@@ -147,6 +180,7 @@ pub fn csv(s: &Sweep) -> anyhow::Result<String> {
             e(r.speedup),
             e(r.efficiency),
             e(r.physics_cpu_seconds),
+            e(r.cpu_over_off),
             oe(r.serial_measured),
             oe(r.karp_flatt),
             r.same_bits.to_string(),

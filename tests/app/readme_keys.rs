@@ -1,6 +1,7 @@
-//! README.md's "## Keys" table lists exactly the keys the app binds
-//! (`ballpit::tui::keys::TABLE`, which also drives dispatch, the `?`
-//! overlay and the key bar). A row's first cell holds its keys in
+//! README.md's and docs/design.md's "## Keys" tables list exactly the keys
+//! the app binds (`ballpit::tui::keys::TABLE`, which also drives dispatch,
+//! the `?` overlay and the key bar): a key cannot be added, or dropped,
+//! without both documents. A row's first cell holds its keys in
 //! backticks ("`p`/`P`", "`q`, `Esc`, `Ctrl-C`", "`←`/`→`/`↑`/`↓`"); a
 //! cell without backticks may say "arrows" for the four arrow keys.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
@@ -8,11 +9,11 @@ use ballpit::tui::keys::TABLE;
 use std::collections::BTreeSet;
 
 /// The key names in the first column of the table under `## Keys`.
-fn readme_keys(readme: &str) -> BTreeSet<String> {
-    let section = readme
+fn table_keys(markdown: &str) -> BTreeSet<String> {
+    let section = markdown
         .split("\n## ")
         .find(|s| s.starts_with("Keys"))
-        .expect("README.md has a \"## Keys\" section");
+        .expect("a \"## Keys\" section");
     let mut keys = BTreeSet::new();
     let rows = section.lines().filter(|l| l.trim_start().starts_with('|'));
     // The header row and the |---| separator come first.
@@ -52,7 +53,7 @@ fn the_parser_reads_backticks_slashes_commas_and_words() {
               | `[`/`]` | tick |\n| arrows | camera |\n| `space` | pause |\n\
               | `←`/`→` | also arrows |\n\
               \n## Next\n| `z` | not a key |\n";
-    let got: Vec<String> = readme_keys(md).into_iter().collect();
+    let got: Vec<String> = table_keys(md).into_iter().collect();
     assert_eq!(
         got,
         [
@@ -61,16 +62,26 @@ fn the_parser_reads_backticks_slashes_commas_and_words() {
     );
 }
 
-#[test]
-fn readme_keys_are_the_apps_keys() {
-    let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md"))
-        .expect("README.md");
-    let doc = readme_keys(&readme);
+/// `file`'s key table against the app's: what it lacks and what it adds.
+fn check(file: &str) {
+    let text =
+        std::fs::read_to_string(format!("{}/{file}", env!("CARGO_MANIFEST_DIR"))).expect(file);
+    let doc = table_keys(&text);
     let app = app_keys();
     let missing: Vec<_> = app.difference(&doc).collect();
     let extra: Vec<_> = doc.difference(&app).collect();
     assert!(
         missing.is_empty() && extra.is_empty(),
-        "README's ## Keys lacks {missing:?} and lists {extra:?} that the app does not bind"
+        "{file}'s ## Keys lacks {missing:?} and lists {extra:?} that the app does not bind"
     );
+}
+
+#[test]
+fn readme_keys_are_the_apps_keys() {
+    check("README.md");
+}
+
+#[test]
+fn design_keys_are_the_apps_keys() {
+    check("docs/design.md");
 }

@@ -398,8 +398,10 @@ fn focus_events_a_paste_and_a_burst_of_keys_do_not_end_the_app() {
     assert!(app.wait_exit(3.0).expect("q ends the app").success());
 }
 
-#[test]
-fn empty_and_one_cell_terminals_and_term_dumb_neither_panic_nor_spin() {
+/// Empty and one-cell terminals and `TERM=dumb`: the app stays alive at
+/// that size and recovers when the terminal grows; with `max_load`, it also
+/// stays nearly idle there (a spin would take a whole core).
+fn tiny_terminals(max_load: Option<f64>) {
     for (size, term) in [
         ((0, 0), "xterm-256color"),
         ((1, 1), "xterm"),
@@ -408,13 +410,13 @@ fn empty_and_one_cell_terminals_and_term_dumb_neither_panic_nor_spin() {
         let mut app = start_with(&["--count", "100"], None, (40, 120), term);
         app.wait_for("the readouts", 10.0, |s| tick(s).is_some());
         app.resize(size.0, size.1);
-        // Over a second at that size, the app stays alive and nearly idle:
-        // a spin would take a whole core.
         let (c0, t0) = (app.cpu_seconds(), Instant::now());
         thread::sleep(Duration::from_millis(1500));
         let load = (app.cpu_seconds() - c0) / t0.elapsed().as_secs_f64();
         assert!(app.alive(), "{size:?} {term}: the app ended");
-        assert!(load < 0.5, "{size:?} {term}: {load:.2} of a core");
+        if let Some(max) = max_load {
+            assert!(load < max, "{size:?} {term}: {load:.2} of a core");
+        }
         // Back to a usable size the screen recovers; `q` quits.
         app.resize_and_wait(24, 80, "tick");
         app.send("q");
@@ -423,9 +425,21 @@ fn empty_and_one_cell_terminals_and_term_dumb_neither_panic_nor_spin() {
     }
 }
 
+#[test]
+fn empty_and_one_cell_terminals_and_term_dumb_do_not_panic() {
+    tiny_terminals(None);
+}
+
+#[test]
+#[ignore = "CPU-load bound: .ci/run runs it in its timing step (cargo test --release -- --ignored), retried once"]
+fn empty_and_one_cell_terminals_and_term_dumb_do_not_spin() {
+    tiny_terminals(Some(0.5));
+}
+
 /// Paused, the app waits for keys: over two seconds it takes next to no
 /// CPU (the thread panel's sampling and a redraw a second), flat out or not.
 #[test]
+#[ignore = "CPU-load bound: .ci/run runs it in its timing step (cargo test --release -- --ignored), retried once"]
 fn a_paused_app_takes_next_to_no_cpu() {
     for args in [&[][..], &["--tick", "max"][..]] {
         let mut app = start_with(args, None, (24, 80), "xterm-256color");

@@ -6,7 +6,7 @@
 //! them, as a real terminal does. Shared by `tests/app/slow_link.rs` and
 //! `examples/slow_link.rs` (which compiles `child.rs` beside it by path).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
-#![allow(dead_code)]
+#![allow(dead_code)] // examples/slow_link.rs compiles this file too, and each uses part of it
 use crossbeam_channel::{Receiver, Sender, unbounded};
 use portable_pty::{CommandBuilder, MasterPty, PtySize, native_pty_system};
 use std::io::{Read, Write};
@@ -62,11 +62,10 @@ fn sleep_until(t: Instant) {
 const QUERIES: [&[u8]; 3] = [b"\x1b[5n", b"\x1b[6n", b"\x1b[c"];
 
 impl Link {
-    #[allow(clippy::too_many_lines)]
-    // the link's three threads, set up in one place
     // Each end of the link is a thread; the far one scans every chunk for
     // the terminal queries it answers.
-    #[allow(clippy::excessive_nesting)]
+    #[allow(clippy::too_many_lines)] // the link's three threads, set up in one place
+    #[allow(clippy::excessive_nesting)] // the far end's loop: read, scan, answer, forward
     pub fn start(mut cmd: CommandBuilder, spec: Spec) -> Link {
         let pty = native_pty_system()
             .openpty(PtySize {

@@ -21,4 +21,5 @@ mod readme;
 mod scaling;
 mod scene_files;
 mod scenes;
+mod synopsis;
 mod timer;

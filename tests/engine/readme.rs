@@ -114,15 +114,53 @@ fn slug_is_githubs() {
     assert_eq!(slug("Parts (`parts.rs`)"), "parts-partsrs");
 }
 
+/// The anchors a markdown file offers: its headings' slugs and the ids of
+/// its `<a id="..."></a>` marks (which docs/figures.md puts on table rows).
+fn anchors(body: &str) -> Vec<String> {
+    let headings = body
+        .lines()
+        .filter_map(|l| l.strip_prefix('#'))
+        .map(|h| slug(h.trim_start_matches('#')));
+    let ids = body
+        .split("<a id=\"")
+        .skip(1)
+        .filter_map(|p| p.split('"').next())
+        .map(str::to_string);
+    headings.chain(ids).collect()
+}
+
 #[test]
-fn every_link_between_the_docs_lands() {
+fn anchors_are_headings_and_row_marks() {
+    let body = "# Top\n\n## A `b` c\n| <a id=\"row-1\"></a>x | y |\n";
+    assert_eq!(anchors(body), ["top", "a-b-c", "row-1"]);
+}
+
+/// README.md and every markdown file under docs/, subfolders included.
+fn doc_files() -> Vec<PathBuf> {
     let mut files = vec![root().join("README.md")];
-    for e in std::fs::read_dir(root().join("docs")).unwrap() {
-        let p = e.unwrap().path();
-        if p.extension().is_some_and(|x| x == "md") {
-            files.push(p);
+    let mut dirs = vec![root().join("docs")];
+    while let Some(dir) = dirs.pop() {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                dirs.push(p);
+            } else if p.extension().is_some_and(|x| x == "md") {
+                files.push(p);
+            }
         }
     }
+    files
+}
+
+#[test]
+fn every_link_between_the_docs_lands() {
+    let files = doc_files();
+    assert!(
+        files
+            .iter()
+            .any(|f| f.ends_with("docs/history/2026-11-22.md")),
+        "the walk reaches docs/history/"
+    );
     let mut checked = 0;
     for file in &files {
         let text = std::fs::read_to_string(file).unwrap();
@@ -140,11 +178,8 @@ fn every_link_between_the_docs_lands() {
             assert!(target.exists(), "{}: {link} is not there", file.display());
             if !anchor.is_empty() {
                 let body = std::fs::read_to_string(&target).unwrap();
-                let found = body
-                    .lines()
-                    .filter_map(|l| l.strip_prefix('#'))
-                    .any(|h| slug(h.trim_start_matches('#')) == anchor);
-                assert!(found, "{}: no heading #{anchor} in {path}", file.display());
+                let found = anchors(&body).iter().any(|a| a == anchor);
+                assert!(found, "{}: no anchor #{anchor} in {path}", file.display());
             }
             checked += 1;
         }

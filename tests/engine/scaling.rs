@@ -7,6 +7,7 @@ use crate::common::pty;
 
 use ballpit::engine::Threading;
 use ballpit::scaling::{CSV_COLUMNS, configs};
+use std::path::PathBuf;
 use std::time::Duration;
 
 const TINY: [&str; 8] = [
@@ -29,15 +30,13 @@ fn scaling(args: &[&str]) -> std::process::Output {
         .unwrap()
 }
 
-fn cores() -> usize {
-    std::thread::available_parallelism().map_or(1, std::num::NonZero::get)
-}
-
-#[test]
-fn a_tiny_sweep_prints_every_column_and_writes_csv_and_svg() {
-    let dir = scratch("scaling");
+/// The tiny sweep on `count` spheres into a scratch `out`: the scratch
+/// directory, `out` and the table printed.
+fn tiny_sweep(name: &str, count: &str) -> (PathBuf, PathBuf, String) {
+    let dir = scratch(name);
     let out_dir = dir.join("out");
     let mut args = TINY.to_vec();
+    args[1] = count;
     args.extend(["--out", out_dir.to_str().unwrap()]);
     let out = scaling(&args);
     assert!(
@@ -45,7 +44,16 @@ fn a_tiny_sweep_prints_every_column_and_writes_csv_and_svg() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let table = String::from_utf8(out.stdout).unwrap();
+    (dir, out_dir, String::from_utf8(out.stdout).unwrap())
+}
+
+fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, std::num::NonZero::get)
+}
+
+#[test]
+fn a_tiny_sweep_prints_every_column_and_writes_csv_and_svg() {
+    let (dir, out_dir, table) = tiny_sweep("scaling", "300");
     for col in [
         "mode",
         "threads",
@@ -81,26 +89,6 @@ fn a_tiny_sweep_prints_every_column_and_writes_csv_and_svg() {
         table.contains("Every run ended in the same bits as off."),
         "{table}"
     );
-    if cores() >= 2 {
-        let f: f64 = table
-            .split("serial fraction ")
-            .nth(1)
-            .and_then(|t| t.split_whitespace().next())
-            .unwrap()
-            .parse()
-            .unwrap();
-        assert!((0.0..=1.0).contains(&f), "fitted fraction {f}");
-        assert!(
-            table.contains("Predicted by that fit, not measured"),
-            "{table}"
-        );
-        for c in ["16 cores", "64 cores", "128 cores"] {
-            assert!(table.contains(c), "{table}");
-        }
-    } else {
-        assert!(table.contains("no serial fraction to fit"), "{table}");
-    }
-
     let csv = std::fs::read_to_string(out_dir.join("scaling.csv")).unwrap();
     let mut lines = csv.lines();
     assert_eq!(lines.next().unwrap(), CSV_COLUMNS.join(","));
@@ -108,7 +96,8 @@ fn a_tiny_sweep_prints_every_column_and_writes_csv_and_svg() {
     assert!(body.iter().all(|r| r.len() == CSV_COLUMNS.len()), "{csv}");
     let measured: Vec<&Vec<&str>> = body.iter().filter(|r| r[0] != "predicted").collect();
     assert_eq!(measured.len(), sweep.len(), "{csv}");
-    assert!(measured.iter().all(|r| r[12] == "true"), "same bits: {csv}");
+    assert!(measured.iter().all(|r| r[13] == "true"), "same bits: {csv}");
+    fractions_within_0_and_1(&measured, &csv);
     let pools = measured
         .iter()
         .filter(|r| r[0] == Threading::Pool.name())
@@ -116,6 +105,11 @@ fn a_tiny_sweep_prints_every_column_and_writes_csv_and_svg() {
     assert_eq!(pools, 3, "{csv}");
     let predicted = body.len() - measured.len();
     assert_eq!(predicted, if cores() >= 2 { 3 } else { 0 }, "{csv}");
+    if cores() >= 2 {
+        the_fit_lies_among_the_pools_fractions(&table, &body);
+    } else {
+        assert!(table.contains("no serial fraction to fit"), "{table}");
+    }
 
     let svg = std::fs::read_to_string(out_dir.join("scaling.svg")).unwrap();
     assert!(
@@ -123,6 +117,94 @@ fn a_tiny_sweep_prints_every_column_and_writes_csv_and_svg() {
         "{svg:.200}"
     );
     assert!(svg.contains("pool, measured"), "{svg:.200}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The CSV's measured serial fraction and Karp–Flatt cells: empty or in
+/// [0, 1], however slow a pool ran.
+fn fractions_within_0_and_1(rows: &[&Vec<&str>], csv: &str) {
+    for r in rows {
+        for cell in [r[11], r[12]] {
+            if !cell.is_empty() {
+                let f: f64 = cell.parse().unwrap();
+                assert!((0.0..=1.0).contains(&f), "{cell} in {csv}");
+            }
+        }
+    }
+}
+
+/// The fit is a weighted mean of the fitted pools' Karp–Flatt fractions
+/// (clamped to [0, 1]): the printed fraction lies between the least and
+/// the greatest of them, and it is the one the CSV's predictions come from.
+fn the_fit_lies_among_the_pools_fractions(table: &str, body: &[Vec<&str>]) {
+    let f: f64 = table
+        .split("serial fraction ")
+        .nth(1)
+        .and_then(|t| t.split_whitespace().next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    let num = |c: &str| c.parse::<f64>().unwrap();
+    let kf = |s: f64, p: f64| ((1.0 / s - 1.0 / p) / (1.0 - 1.0 / p)).clamp(0.0, 1.0);
+    let fitted: Vec<f64> = body
+        .iter()
+        .filter(|r| r[0] == Threading::Pool.name())
+        .filter(|r| num(r[2]) > 1.0 && num(r[1]) <= cores() as f64)
+        .map(|r| kf(num(r[7]), num(r[2])))
+        .collect();
+    assert!(!fitted.is_empty(), "{table}");
+    let lo = fitted.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = fitted.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    assert!(
+        lo - 5e-4 <= f && f <= hi + 5e-4,
+        "fit {f} outside the pools' fractions {fitted:?}:\n{table}"
+    );
+    let at16 = body.iter().find(|r| r[0] == "predicted" && r[1] == "16");
+    let from_prediction = kf(num(at16.unwrap()[7]), 16.0);
+    assert!(
+        (from_prediction - f).abs() <= 5e-4,
+        "the predictions come from {from_prediction}, the table says {f}:\n{table}"
+    );
+    assert!(
+        table.contains("Predicted by that fit, not measured"),
+        "{table}"
+    );
+    for c in ["16 cores", "64 cores", "128 cores"] {
+        assert!(table.contains(c), "{table}");
+    }
+}
+
+#[test]
+fn an_empty_scene_is_refused_with_the_range() {
+    let out = scaling(&["--count", "0"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--count must be 1 to 10000000"), "{err}");
+    assert_eq!(err.lines().count(), 1, "one message: {err}");
+    assert!(out.stdout.is_empty());
+}
+
+#[test]
+fn one_sphere_is_said_to_have_nothing_to_share() {
+    let (dir, out_dir, table) = tiny_sweep("scaling-one", "1");
+    let says: Vec<&str> = table
+        .lines()
+        .filter(|l| l.starts_with("Nothing to share: "))
+        .collect();
+    assert_eq!(says.len(), 1, "{table}");
+    assert!(says[0].contains("on 1 sphere") || cores() < 2, "{table}");
+    // Before the table, not after it.
+    assert!(table.find("Nothing to share").unwrap() < table.find("| mode").unwrap());
+    assert!(!table.contains("packing -"), "{table}");
+    let csv = std::fs::read_to_string(out_dir.join("scaling.csv")).unwrap();
+    let body: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    let measured: Vec<&Vec<&str>> = body.iter().filter(|r| r[0] != "predicted").collect();
+    assert_eq!(measured.len(), configs(2).len(), "{csv}");
+    fractions_within_0_and_1(&measured, &csv);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -4,7 +4,7 @@
 //! pitch near a diameter (1.0035 at a million spheres), colliding several
 //! times faster than the fluid. Checked by the collision rate against
 //! Enskog's after a melt of one `σ / v_rms` (the rate comes within 10 % in
-//! about half of that at 10k, 100k and 1M; docs/benchmarks.md).
+//! about half of that at 10k, 100k and 1M; docs/history/2026-12-02-evening.md).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use ballpit::physics::exact::Exact;
 use ballpit::physics::sphere::volume;

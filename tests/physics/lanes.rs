@@ -88,3 +88,56 @@ fn a_small_scene_keeps_one_lane_of_a_large_pool_busy() {
     assert_eq!((b.busy, b.threads), (1, 64));
     assert_eq!(b.bound, ballpit::physics::exec::Bound::Work);
 }
+
+/// Many lanes on as many cores, at the real lane rule, run one after
+/// another: the step takes its parallel forms (`physics::wide`).
+struct Wide;
+
+impl ballpit::physics::Exec for Wide {
+    fn lanes(&self) -> usize {
+        64
+    }
+    fn cores(&self) -> usize {
+        64
+    }
+    fn for_each_lane(&self, f: &(dyn Fn(usize) + Sync)) {
+        (0..64).rev().for_each(f);
+    }
+    fn join(&self, a: &(dyn Fn() + Sync), b: &(dyn Fn() + Sync)) {
+        b();
+        a();
+    }
+}
+
+/// At 100 000 spheres every parallel form of the step runs at its real
+/// size, and gives the serial forms' bits.
+#[test]
+fn the_parallel_forms_give_the_serial_bits_at_100k() {
+    let n = 100_000;
+    let radius = (0.05 / (n as f64 * 4.0 / 3.0 * std::f64::consts::PI)).cbrt();
+    let world = build_world(&SceneSpec {
+        count: Some(n),
+        radius: Some(radius),
+        speed: Some(0.5),
+        seed: Some(7),
+        ..SceneSpec::default()
+    })
+    .unwrap();
+    let mut reference = world.clone();
+    ModelKind::Swept
+        .build()
+        .advance(&mut reference, DT, 2, &Serial);
+    let (e0, e1) = (world.kinetic_energy(), reference.kinetic_energy());
+    assert!((e1 - e0).abs() <= 1e-9 * e0, "energy {e0} -> {e1}");
+    assert_eq!(reference.escaped(), 0);
+    assert!(reference.counters.sphere_collisions > 1000);
+    for lanes in [&Wide as &dyn ballpit::physics::Exec, &Lanes(3)] {
+        let mut got = world.clone();
+        ModelKind::Swept.build().advance(&mut got, DT, 2, lanes);
+        assert!(
+            bits(&got) == bits(&reference),
+            "{} lanes differ",
+            lanes.lanes()
+        );
+    }
+}

@@ -382,12 +382,17 @@ impl Level {
 
     /// Indices of the spheres in the cells on the faces of the box.
     pub(super) fn on_faces(&self, f: &mut impl FnMut(usize)) {
+        self.on_faces_of(0..self.per_side, f);
+    }
+
+    /// [`Level::on_faces`] of the cells in the planes `zs` alone.
+    pub(super) fn on_faces_of(&self, zs: std::ops::Range<usize>, f: &mut impl FnMut(usize)) {
         if self.entries.len() <= 1 {
             return;
         }
         let (last, s, cs) = (self.per_side - 1, self.side, &self.cell_start);
         let key = |x: usize, y: usize, z: usize| (x + 1) + s * ((y + 1) + s * (z + 1));
-        for z in 0..=last {
+        for z in zs {
             for y in 0..=last {
                 let (a, b) = (key(0, y, z), key(last, y, z));
                 if z == 0 || z == last || y == 0 || y == last {

@@ -13,7 +13,7 @@ mod pairs;
 mod place;
 mod sizing;
 
-use super::exec::{Exec, PerBlock, for_each_chunk};
+use super::exec::{Exec, PerBlock, for_each_block, for_each_chunk};
 use super::sphere::Sphere;
 use entry::{Ball, Entry, Source};
 use glam::DVec3;
@@ -26,6 +26,8 @@ const ALL_PAIRS_MAX: usize = 24;
 const LANES_MIN_SPHERES: usize = 4096;
 /// Spheres per parallel block while binning.
 const BUILD_BLOCK: usize = 4096;
+/// Planes of cells per parallel block when finding the balls on faces.
+const FACE_PLANES: usize = 8;
 /// The first level's cell comes from every this-many-th reach.
 const SAMPLE_STRIDE: usize = 32;
 /// From this many spheres on, the first level is staged as cell keys alone
@@ -55,6 +57,8 @@ pub struct Grid {
     /// in parallel, joined in block order).
     wide: PerBlock<Vec<(Ball, u32)>>,
     slots: PerBlock<Vec<Pair>>,
+    /// Per block of planes of cells, the spheres `near_faces_lanes` found.
+    faces: PerBlock<Vec<u32>>,
 }
 
 /// The first level's records as cell keys and the spheres they come from.
@@ -338,6 +342,47 @@ impl Grid {
         for (b, id) in &self.top {
             if out(b) {
                 f(*id);
+            }
+        }
+    }
+
+    /// [`Grid::near_faces`] on `exec`'s lanes, the spheres `keep` takes
+    /// into `out` in the order `near_faces` gives them: each level's planes
+    /// of cells in blocks, each block's finds joined in block order.
+    pub fn near_faces_lanes(
+        &mut self,
+        exec: &dyn Exec,
+        keep: &(dyn Fn(u32) -> bool + Sync),
+        out: &mut Vec<u32>,
+    ) {
+        out.clear();
+        let size = self.size;
+        let reaches = move |b: &Ball| {
+            (b.pos.min_element() - b.reach <= 0.0) | (b.pos.max_element() + b.reach >= size)
+        };
+        for level in &self.levels {
+            let blocks = level.per_side.div_ceil(FACE_PLANES);
+            self.faces.ensure(blocks);
+            let faces = &self.faces;
+            let take = |j: usize, found: &mut Vec<u32>| {
+                let e = &level.entries[j];
+                if reaches(&e.ball) && keep(e.id) {
+                    found.push(e.id);
+                }
+            };
+            for_each_block(exec, blocks, &|b| {
+                let mut found = faces[b].lock();
+                found.clear();
+                let zs = b * FACE_PLANES..((b + 1) * FACE_PLANES).min(level.per_side);
+                level.on_faces_of(zs, &mut |j| take(j, &mut found));
+            });
+            for f in &self.faces[..blocks] {
+                out.extend_from_slice(&f.lock());
+            }
+        }
+        for (b, id) in &self.top {
+            if reaches(b) && keep(*id) {
+                out.push(*id);
             }
         }
     }

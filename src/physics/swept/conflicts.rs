@@ -8,13 +8,16 @@ use super::partition::{Partition, Slot};
 use super::path_ball;
 use super::stats::RoundStats;
 use crate::physics::broad::Grid;
-use crate::physics::exec::{Exec, Serial};
+use crate::physics::exec::{Exec, Serial, for_each_chunk};
 use crate::physics::sphere::Sphere;
+use crate::physics::wide::wide;
 use glam::DVec3;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Fewer grown balls than this are compared on one lane.
 const LANES_MIN_BALLS: usize = 2048;
+/// Slots per block when making their balls in parallel.
+const BALL_BLOCK: usize = 2048;
 
 /// By slot, what the cluster's last finished run left.
 #[derive(Default)]
@@ -132,6 +135,7 @@ impl Finished {
 
     /// The ball slot `s` (sphere `id`) stays in: from its last finished
     /// run (around the same centre), or its straight path.
+    #[inline]
     fn ball(&self, s: usize, id: u32, spheres: &[Sphere], dt: f64) -> (DVec3, f64) {
         let straight = path_ball(&spheres[id as usize], dt);
         match self.record(s) {
@@ -205,13 +209,22 @@ impl Conflicts {
             return;
         }
         // Merges since the round began joined clusters: name them afresh.
-        self.cluster_of.clear();
-        self.cluster_of
-            .extend((0..m).map(|s| part.find(Slot::at(s))));
+        part.roots_into(exec, &mut self.cluster_of);
         // Every slot's ball, indexed by slot.
         self.balls.clear();
-        for s in 0..m {
-            self.balls.push(fin.ball(s, part.ids[s], spheres, dt));
+        if wide(exec) {
+            self.balls.resize(m, (DVec3::ZERO, 0.0));
+            let ids = &part.ids;
+            for_each_chunk(exec, &mut self.balls, BALL_BLOCK, &|b, chunk| {
+                for (k, ball) in chunk.iter_mut().enumerate() {
+                    let s = b * BALL_BLOCK + k;
+                    *ball = fin.ball(s, ids[s], spheres, dt);
+                }
+            });
+        } else {
+            for s in 0..m {
+                self.balls.push(fin.ball(s, part.ids[s], spheres, dt));
+            }
         }
         self.overlap.build(
             &self.balls,

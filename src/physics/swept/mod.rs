@@ -36,6 +36,7 @@ use super::exec::{Exec, PerBlock, for_each_block_of, for_each_chunk};
 use super::flight::fly;
 use super::model::{Model, ModelKind};
 use super::sphere::{Sphere, overlap_rel};
+use super::wide::wide;
 use super::world::World;
 use cluster::Coarse;
 use glam::DVec3;
@@ -303,17 +304,29 @@ impl Swept {
             if self.detect.overran {
                 return 0.0;
             }
-            let hits = &mut self.hits;
-            self.detect.grid.near_faces(&mut |i| {
-                if reaches_wall(&sp[i as usize], size, dt) {
-                    hits.push(i);
-                }
-            });
+            self.grid_hits(exec, sp, size, dt);
         }
         if self.detect.overran {
             return 0.0;
         }
         self.sort_pairs(sp, dt, exec)
+    }
+
+    /// The spheres the grid has on a face whose path reaches a wall, into
+    /// `hits`: on many lanes block by block of planes, in the same order.
+    fn grid_hits(&mut self, exec: &dyn Exec, sp: &[Sphere], size: f64, dt: f64) {
+        let keep = |i: u32| reaches_wall(&sp[i as usize], size, dt);
+        if wide(exec) {
+            let grid = &mut self.detect.grid;
+            grid.near_faces_lanes(exec, &keep, &mut self.hits);
+            return;
+        }
+        let hits = &mut self.hits;
+        self.detect.grid.near_faces(&mut |i| {
+            if keep(i) {
+                hits.push(i);
+            }
+        });
     }
 
     /// Splits the pairs whose balls overlap into those whose straight paths

@@ -2,8 +2,17 @@
 //! slots are joined into clusters by union-find (each cluster's slots also
 //! form a cycle, so a merged cluster's members are found without scanning
 //! everyone), and each round's clusters to run are laid out with their
-//! members and meeting pairs.
-use super::group::group;
+//! members and meeting pairs. On many lanes (`wide.rs`) the slots are
+//! numbered and the first round laid out in parallel, to the same bits.
+use super::group::{Buckets, group, group_wide, wide_group};
+use crate::physics::exec::{Exec, PerBlock, for_each_block, spans};
+use crate::physics::wide::wide;
+use parking_lot::Mutex;
+
+/// Spheres per block when numbering the slots in parallel.
+const NUMBER_BLOCK: usize = 8192;
+/// Slots per block when finding their roots in parallel.
+const ROOT_BLOCK: usize = 4096;
 
 /// A sphere's place among the spheres with events of a step part: what
 /// everything kept by slot is indexed with, never a sphere id.
@@ -77,12 +86,30 @@ pub(super) struct Partition {
     /// pairs (meeting or near) start in `partners`.
     pub partner_start: Vec<u32>,
     pub partners: Vec<u32>,
+    /// Whether `meet_start` and `meets_of` are this part's (only rounds
+    /// after the first read them).
+    meets_indexed: bool,
+    /// By slot, its cluster's root, when the first round is laid out.
+    roots: Vec<Slot>,
+    /// By root slot, where its members and pairs start in the batch.
+    member_start: Vec<u32>,
+    pair_start: Vec<u32>,
+    /// Scratch of the parallel forms.
+    ids_buckets: Buckets<u32>,
+    pair_buckets: Buckets<(u32, u32)>,
+    marked: PerBlock<u32>,
 }
 
 impl Partition {
     /// Slots for the spheres of the pairs that meet and those that reach a
     /// wall, in sphere order, each its own cluster; returns how many.
-    pub fn start(&mut self, n: usize, meets: &[(u32, u32)], hits: &[u32]) -> usize {
+    pub fn start(
+        &mut self,
+        exec: &dyn Exec,
+        n: usize,
+        meets: &[(u32, u32)],
+        hits: &[u32],
+    ) -> usize {
         for &i in &self.ids {
             self.slot[i as usize] = Slot::NONE;
         }
@@ -97,12 +124,17 @@ impl Partition {
         for &i in hits {
             self.slot[i as usize] = Slot(0);
         }
-        for (i, slot) in self.slot.iter_mut().enumerate() {
-            if !slot.is_none() {
-                *slot = Slot::at(self.ids.len());
-                self.ids.push(i as u32);
+        if wide(exec) && n >= 2 * NUMBER_BLOCK.min(exec.min_work()) {
+            self.number_wide(exec);
+        } else {
+            for (i, slot) in self.slot.iter_mut().enumerate() {
+                if !slot.is_none() {
+                    *slot = Slot::at(self.ids.len());
+                    self.ids.push(i as u32);
+                }
             }
         }
+        self.meets_indexed = false;
         self.meet_slot.clear();
         self.meet_slot
             .extend(meets.iter().map(|&(i, _)| self.slot[i as usize]));
@@ -118,9 +150,48 @@ impl Partition {
         m
     }
 
+    /// The marked slots numbered in sphere order, in parallel blocks: each
+    /// block counts its marks, then numbers them from the count before it.
+    fn number_wide(&mut self, exec: &dyn Exec) {
+        let blocks = self.slot.len().div_ceil(NUMBER_BLOCK);
+        self.marked.ensure(blocks);
+        let (slot, marked) = (&self.slot, &self.marked);
+        for_each_block(exec, blocks, &|b| {
+            let mine = &slot[b * NUMBER_BLOCK..((b + 1) * NUMBER_BLOCK).min(slot.len())];
+            *marked[b].lock() = mine.iter().filter(|s| !s.is_none()).count() as u32;
+        });
+        let counts: Vec<usize> = self.marked[..blocks]
+            .iter_mut()
+            .map(|c| *c.get_mut() as usize)
+            .collect();
+        self.ids.resize(counts.iter().sum(), 0);
+        let firsts: Vec<usize> = counts
+            .iter()
+            .scan(0, |at, &c| {
+                let first = *at;
+                *at += c;
+                Some(first)
+            })
+            .collect();
+        let ids = spans(&mut self.ids, counts.iter().copied());
+        let slots: Vec<Mutex<&mut [Slot]>> =
+            self.slot.chunks_mut(NUMBER_BLOCK).map(Mutex::new).collect();
+        for_each_block(exec, blocks, &|b| {
+            let (mut slot, mut ids) = (slots[b].lock(), ids[b].lock());
+            let mut k = 0;
+            for (i, s) in slot.iter_mut().enumerate() {
+                if !s.is_none() {
+                    *s = Slot::at(firsts[b] + k);
+                    ids[k] = (b * NUMBER_BLOCK + i) as u32;
+                    k += 1;
+                }
+            }
+        });
+    }
+
     /// The first clusters: the spheres of each pair that meets, or whose
     /// balls overlap with both having events, run together.
-    pub fn join_pairs(&mut self, meets: &[(u32, u32)], near: &[(u32, u32)]) {
+    pub fn join_pairs(&mut self, exec: &dyn Exec, meets: &[(u32, u32)], near: &[(u32, u32)]) {
         for &(i, j) in meets {
             self.union(self.slot[i as usize], self.slot[j as usize]);
         }
@@ -130,14 +201,34 @@ impl Partition {
                 self.union(a, b);
             }
         }
-        self.index_partners(meets, near);
+        self.index_partners(exec, meets, near);
     }
 
     /// Each first-round slot's partners among the pairs the grid found
     /// (counting sort by slot): a rescan whose ball lies inside the
     /// sphere's binned one finds everyone it can meet among them.
-    fn index_partners(&mut self, meets: &[(u32, u32)], near: &[(u32, u32)]) {
-        let slot = &self.slot;
+    fn index_partners(&mut self, exec: &dyn Exec, meets: &[(u32, u32)], near: &[(u32, u32)]) {
+        let (slot, m) = (&self.slot, self.ids.len());
+        let ends = |i: u32, j: u32| {
+            [(i, j), (j, i)].into_iter().filter_map(|(k, other)| {
+                let a = slot[k as usize];
+                (!a.is_none()).then_some((a.0, other))
+            })
+        };
+        let len = meets.len() + near.len();
+        if wide_group(exec, m, len) {
+            // Source positions `r` of the meeting pairs followed by the near.
+            let by_slot = |r: std::ops::Range<usize>| {
+                let (k, e) = (meets.len(), r.end);
+                let pairs = meets[r.start.min(k)..e.min(k)]
+                    .iter()
+                    .chain(&near[r.start.max(k) - k..e.max(k) - k]);
+                pairs.flat_map(|&(i, j)| ends(i, j))
+            };
+            let (starts, out) = (&mut self.partner_start, &mut self.partners);
+            group_wide(exec, &mut self.ids_buckets, starts, out, m, len, &by_slot);
+            return;
+        }
         let ends = meets
             .iter()
             .chain(near)
@@ -146,12 +237,7 @@ impl Partition {
             let a = slot[k as usize];
             (!a.is_none()).then_some((a.0, other))
         });
-        group(
-            &mut self.partner_start,
-            &mut self.partners,
-            self.ids.len(),
-            by_slot,
-        );
+        group(&mut self.partner_start, &mut self.partners, m, by_slot);
     }
 
     pub fn find(&mut self, mut x: Slot) -> Slot {
@@ -226,16 +312,22 @@ impl Partition {
     /// run, with their members and meeting pairs, into `batch`: every
     /// cluster in the `first` round, only those marked dirty later, each
     /// found by walking its cycle.
-    pub fn partition(&mut self, meets: &[(u32, u32)], first: bool, batch: &mut Batch) {
+    pub fn partition(
+        &mut self,
+        exec: &dyn Exec,
+        meets: &[(u32, u32)],
+        first: bool,
+        batch: &mut Batch,
+    ) {
         batch.todo.clear();
         batch.order.clear();
         batch.pairs.clear();
         if self.whole {
             self.partition_whole(meets, batch);
         } else if first {
-            self.partition_all(meets, batch);
+            self.partition_all(exec, meets, batch);
         } else {
-            self.partition_dirty(meets, batch);
+            self.partition_dirty(exec, meets, batch);
         }
     }
 
@@ -261,9 +353,13 @@ impl Partition {
         }
     }
 
-    fn partition_all(&mut self, meets: &[(u32, u32)], batch: &mut Batch) {
+    fn partition_all(&mut self, exec: &dyn Exec, meets: &[(u32, u32)], batch: &mut Batch) {
         self.dirty_roots.clear();
-        self.index_meets(meets);
+        if wide_group(exec, self.ids.len(), self.ids.len()) {
+            self.partition_wide(exec, meets, batch);
+            return;
+        }
+        self.index_meets(exec, meets);
         // Every cluster, by root (a root is its own parent), walked round
         // its cycle.
         for root in (0..self.ids.len()).map(Slot::at) {
@@ -273,16 +369,98 @@ impl Partition {
         }
     }
 
-    /// Each first-round slot's meeting pairs (as the pair's first sphere).
-    fn index_meets(&mut self, meets: &[(u32, u32)]) {
-        debug_assert_eq!(self.meet_slot.len(), meets.len());
-        let by_slot = self.meet_slot.iter().map(|s| s.0).zip(0..);
-        group(
-            &mut self.meet_start,
-            &mut self.meets_of,
-            self.first_late,
-            by_slot,
+    /// [`Partition::partition_all`] in parallel: every cluster, in order of
+    /// its root (its lowest slot), with its members in slot order (the
+    /// sphere order, in the first round) and its meeting pairs in detection
+    /// order, as the slots and the pairs grouped by their root.
+    fn partition_wide(&mut self, exec: &dyn Exec, meets: &[(u32, u32)], batch: &mut Batch) {
+        let mut roots = std::mem::take(&mut self.roots);
+        self.roots_into(exec, &mut roots);
+        self.roots = roots;
+        let m = self.ids.len();
+        let (roots, ids, meet_slot) = (&self.roots, &self.ids, &self.meet_slot);
+        let members = |r: std::ops::Range<usize>| r.map(|s| (roots[s].0, ids[s]));
+        let (starts, order) = (&mut self.member_start, &mut batch.order);
+        group_wide(exec, &mut self.ids_buckets, starts, order, m, m, &members);
+        let pairs = |r: std::ops::Range<usize>| {
+            let first = meet_slot[r.clone()].iter();
+            first.zip(&meets[r]).map(|(s, &p)| (roots[s.index()].0, p))
+        };
+        let (starts, out) = (&mut self.pair_start, &mut batch.pairs);
+        group_wide(
+            exec,
+            &mut self.pair_buckets,
+            starts,
+            out,
+            m,
+            meets.len(),
+            &pairs,
         );
+        let (ms, ps) = (&self.member_start, &self.pair_start);
+        for (r, root) in roots.iter().enumerate() {
+            if root.index() == r {
+                batch.todo.push(Todo {
+                    m0: ms[r],
+                    m1: ms[r + 1],
+                    p0: ps[r],
+                    p1: ps[r + 1],
+                });
+            }
+        }
+    }
+
+    /// Every slot's root into `out`: on many lanes in parallel blocks, each
+    /// slot climbing on its own; else by `find`.
+    pub fn roots_into(&mut self, exec: &dyn Exec, out: &mut Vec<Slot>) {
+        let m = self.ids.len();
+        out.clear();
+        if !(wide(exec) && m >= 2 * ROOT_BLOCK.min(exec.min_work())) {
+            out.extend((0..m).map(|s| self.find(Slot::at(s))));
+            return;
+        }
+        out.resize(m, Slot::NONE);
+        let parent = &self.parent;
+        let chunks: Vec<Mutex<&mut [Slot]>> = out.chunks_mut(ROOT_BLOCK).map(Mutex::new).collect();
+        for_each_block(exec, chunks.len(), &|b| {
+            for (k, r) in chunks[b].lock().iter_mut().enumerate() {
+                let mut x = Slot::at(b * ROOT_BLOCK + k);
+                while parent[x.index()] != x {
+                    x = parent[x.index()];
+                }
+                *r = x;
+            }
+        });
+    }
+
+    /// Each first-round slot's meeting pairs (as the pair's first sphere),
+    /// once a round after the first needs them.
+    fn index_meets(&mut self, exec: &dyn Exec, meets: &[(u32, u32)]) {
+        debug_assert_eq!(self.meet_slot.len(), meets.len());
+        if self.meets_indexed {
+            return;
+        }
+        self.meets_indexed = true;
+        let (starts, out) = (&mut self.meet_start, &mut self.meets_of);
+        if wide_group(exec, self.first_late, meets.len()) {
+            let slots = &self.meet_slot;
+            let by_slot = |r: std::ops::Range<usize>| {
+                let from = r.start as u32;
+                slots[r].iter().map(|s| s.0).zip(from..)
+            };
+            let buckets = &mut self.ids_buckets;
+            group_wide(
+                exec,
+                buckets,
+                starts,
+                out,
+                self.first_late,
+                meets.len(),
+                &by_slot,
+            );
+            return;
+        }
+        let by_slot = self.meet_slot.iter().map(|s| s.0).zip(0..);
+        group(starts, out, self.first_late, by_slot);
     }
 
     /// Cluster `root` as a run to make: its members in sphere order and its
@@ -322,7 +500,8 @@ impl Partition {
     /// The clusters marked dirty since the last partition, each with its
     /// members in sphere order and its meeting pairs in detection order
     /// (as the first round has them), in order of their roots.
-    fn partition_dirty(&mut self, meets: &[(u32, u32)], batch: &mut Batch) {
+    fn partition_dirty(&mut self, exec: &dyn Exec, meets: &[(u32, u32)], batch: &mut Batch) {
+        self.index_meets(exec, meets);
         let mut roots = std::mem::take(&mut self.dirty_roots);
         for r in &mut roots {
             *r = self.find(*r);

@@ -122,7 +122,7 @@ impl Rounds {
         budget: u64,
     ) {
         self.work = 0;
-        let serial = self.start(spheres.len(), meets, near, hits);
+        let serial = self.start(exec, spheres.len(), meets, near, hits);
         let mut round = 0;
         loop {
             let mut absorb = serial || round >= PARALLEL_ROUNDS;
@@ -131,14 +131,14 @@ impl Rounds {
                 self.fin.forget();
             }
             let first = self.stats.rounds == 0;
-            self.part.partition(meets, first, &mut self.batch);
+            self.part.partition(exec, meets, first, &mut self.batch);
             // Merges that leave most spheres to run again mean the clusters
             // percolate (dense scenes): one serial run beats more rounds.
             if !absorb && round > 0 && 2 * self.batch.order.len() > self.part.ids.len() {
                 absorb = true;
                 self.part.merge_all();
                 self.fin.forget();
-                self.part.partition(meets, first, &mut self.batch);
+                self.part.partition(exec, meets, first, &mut self.batch);
             }
             if self.batch.todo.is_empty() {
                 break;
@@ -216,8 +216,15 @@ impl Rounds {
 
     /// Slots for the spheres with events and their first clusters; true
     /// when the step runs as one serial loop.
-    fn start(&mut self, n: usize, meets: &[(u32, u32)], near: &[(u32, u32)], hits: &[u32]) -> bool {
-        let m = self.part.start(n, meets, hits);
+    fn start(
+        &mut self,
+        exec: &dyn Exec,
+        n: usize,
+        meets: &[(u32, u32)],
+        near: &[(u32, u32)],
+        hits: &[u32],
+    ) -> bool {
+        let m = self.part.start(exec, n, meets, hits);
         self.fin.reset(m);
         self.conf.cross.clear();
         self.stats = RoundStats {
@@ -234,7 +241,7 @@ impl Rounds {
             self.part.merge_all();
             return true;
         }
-        self.part.join_pairs(meets, near);
+        self.part.join_pairs(exec, meets, near);
         false
     }
 
