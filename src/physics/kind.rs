@@ -52,9 +52,10 @@ impl ModelKind {
     }
 
     /// Whether a run of steps gives the same bits however it is cut into
-    /// `advance` calls: not for `exact` (its schedule is rebuilt at each
-    /// call's end), nor for `auto` (it may run `exact`, and it chooses
-    /// again when the steps per call change).
+    /// `advance` calls: not for `exact` (each call ends by flying every
+    /// sphere to the world's time, `write_back`, and a flight cut in two
+    /// rounds differently from one), nor for `auto` (it may run `exact`,
+    /// and it chooses again when the steps per call change).
     pub fn cuts_freely(self) -> bool {
         matches!(self, ModelKind::Discrete | ModelKind::Swept)
     }

@@ -3,17 +3,15 @@ use super::input::{reader, signals};
 use super::msg::Msg;
 use super::present::{AfterFirstFrame, Presenter, Scene};
 use super::state::AppState;
+use super::Options;
 use super::term::guard::{self, Guard};
 use super::view::readouts::Stats;
 use super::view::theme::Palette;
-use super::{MAX_FPS, Options};
 use crate::cpu::{CpuReport, Sampler};
 use crate::engine::{Command, Engine, Rebuild, Settings, Snapshot};
-use crate::error::BadInput;
 use crate::physics::World;
 use anyhow::{Context, anyhow};
 use crossbeam_channel::{Receiver, RecvTimeoutError};
-use std::io::{self, IsTerminal};
 use std::time::{Duration, Instant};
 
 /// Per-thread CPU is sampled once a second: a minute of history is 60 bars.
@@ -29,7 +27,9 @@ pub struct RunExtras {
     pub after_first_frame: Option<AfterFirstFrame>,
 }
 
-/// Open the screen on `world` and run until the user quits.
+/// Open the screen on `world` and run until the user quits. `opts` come
+/// checked from the command line (`--fps` by clap, the terminal by
+/// `Cli::run_screen`), each check in one place.
 pub fn run(world: World, settings: Settings, opts: Options) -> anyhow::Result<()> {
     run_with(world, settings, opts, RunExtras::default())
 }
@@ -45,21 +45,6 @@ pub fn run_with(
         rebuild,
         after_first_frame,
     } = extras;
-    if !(opts.fps.is_finite() && opts.fps > 0.0 && opts.fps <= MAX_FPS) {
-        return Err(BadInput(format!(
-            "--fps must be greater than 0 and at most {MAX_FPS}, got {}",
-            opts.fps
-        ))
-        .into());
-    }
-    if !(io::stdin().is_terminal() && io::stdout().is_terminal()) {
-        return Err(BadInput(
-            "ballpit's screen needs a terminal, but stdin or stdout is not one; \
-             for a headless run use `ballpit bench`"
-                .into(),
-        )
-        .into());
-    }
     let env = |k: &str| std::env::var(k).ok();
     let palette = Palette::resolve(opts.color, &env);
     let detected = Palette::detect(&env);

@@ -406,6 +406,15 @@ fn every_readme_command_runs_as_written_and_changes_no_tracked_file() {
             if line.is_empty() || line == "cargo test --release" {
                 continue;
             }
+            if line == "cargo run --release" {
+                // This very build's binary, run as the app on its default scene.
+                let here = dir.join("run");
+                std::fs::create_dir_all(&here).unwrap();
+                std::fs::copy(env!("CARGO_BIN_EXE_ballpit"), here.join("ballpit")).unwrap();
+                run_app("ballpit", &work, &here);
+                ran += 1;
+                continue;
+            }
             if line == "cargo install --path ." {
                 // What it leaves: this very build's binary, on the PATH.
                 std::fs::create_dir_all(&bin).unwrap();

@@ -159,7 +159,7 @@ impl Raster {
     }
 
     /// A disc with radii `rx`, `ry` in pixels (the same length on screen).
-    #[allow(clippy::too_many_arguments)]
+    #[allow(clippy::too_many_arguments)] // a disc is its centre, two radii, depth, level, light and ring: plain values, named at the one call
     fn disc(
         &mut self,
         cx: f64,
