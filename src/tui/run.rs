@@ -1,9 +1,9 @@
 //! The frame loop and its pacing.
+use super::Options;
 use super::input::{reader, signals};
 use super::msg::Msg;
 use super::present::{AfterFirstFrame, Presenter, Scene};
 use super::state::AppState;
-use super::Options;
 use super::term::guard::{self, Guard};
 use super::view::readouts::Stats;
 use super::view::theme::Palette;
