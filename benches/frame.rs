@@ -10,9 +10,9 @@
 use ballpit::cpu::CpuReport;
 use ballpit::engine::{Engine, Settings, Snapshot, Threading};
 use ballpit::physics::{ModelKind, Sphere, World};
-use ballpit::tui::app::{self, View};
+use ballpit::tui::backend::{Counting, Lean};
 use ballpit::tui::canvas::{DrawStyle, Raster};
-use ballpit::tui::output::{Counting, Lean};
+use ballpit::tui::layout::{self, View};
 use ballpit::tui::readouts::Stats;
 use ballpit::tui::state::AppState;
 use ballpit::tui::theme::Palette;
@@ -81,7 +81,7 @@ fn terminal(w: u16, h: u16) -> (Term, std::sync::Arc<std::sync::atomic::AtomicU6
 
 fn frame(t: &mut Term, raster: &mut Raster, view: &View) {
     queue!(t.backend_mut(), BeginSynchronizedUpdate).unwrap();
-    t.draw(|f| app::draw(f, raster, view)).unwrap();
+    t.draw(|f| layout::draw(f, raster, view)).unwrap();
     queue!(t.backend_mut(), EndSynchronizedUpdate).unwrap();
 }
 

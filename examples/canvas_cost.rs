@@ -10,8 +10,8 @@ use ballpit::cpu::CpuReport;
 use ballpit::engine::{Engine, Settings, Threading};
 use ballpit::physics::ModelKind;
 use ballpit::scene::SceneSpec;
-use ballpit::tui::app::{self, View};
 use ballpit::tui::canvas::Raster;
+use ballpit::tui::layout::{self, View};
 use ballpit::tui::readouts::Stats;
 use ballpit::tui::state::AppState;
 use ballpit::tui::theme::Palette;
@@ -64,10 +64,10 @@ fn main() -> anyhow::Result<()> {
     };
     let mut raster = Raster::new();
     let mut t = Terminal::new(TestBackend::new(w, h))?;
-    t.draw(|f| app::draw(f, &mut raster, &view))?;
+    t.draw(|f| layout::draw(f, &mut raster, &view))?;
     let c0 = on_cpu().ok_or_else(|| anyhow::anyhow!("no /proc/thread-self/schedstat"))?;
     for _ in 0..frames {
-        t.draw(|f| app::draw(f, &mut raster, &view))?;
+        t.draw(|f| layout::draw(f, &mut raster, &view))?;
     }
     let c1 = on_cpu().unwrap_or(c0);
     println!(

@@ -12,8 +12,8 @@
 use ballpit::cpu::{CpuReport, ThreadLoad, ThreadRole};
 use ballpit::engine::{Engine, Settings, Threading};
 use ballpit::physics::ModelKind;
-use ballpit::tui::app::{self, View};
 use ballpit::tui::canvas::Raster;
+use ballpit::tui::layout::{self, View};
 use ballpit::tui::readouts::Stats;
 use ballpit::tui::state::AppState;
 use ballpit::tui::theme::Palette;
@@ -88,14 +88,14 @@ fn main() -> anyhow::Result<()> {
                 let mut raster = Raster::new();
                 let mut t = Terminal::new(TestBackend::new(w, h))?;
                 for _ in 0..20 {
-                    t.draw(|f| app::draw(f, &mut raster, &view))?;
+                    t.draw(|f| layout::draw(f, &mut raster, &view))?;
                 }
                 let Some(c0) = on_cpu() else {
                     println!("no /proc/thread-self/schedstat here");
                     return Ok(());
                 };
                 for _ in 0..frames {
-                    t.draw(|f| app::draw(f, &mut raster, &view))?;
+                    t.draw(|f| layout::draw(f, &mut raster, &view))?;
                 }
                 let c1 = on_cpu().unwrap_or(c0);
                 println!(

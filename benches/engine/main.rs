@@ -9,9 +9,9 @@
 use ballpit::cpu::CpuReport;
 use ballpit::engine::{Engine, Settings, Snapshot, Threading};
 use ballpit::physics::{Exec, ModelKind, Sphere, World};
-use ballpit::tui::app::{self, View};
+use ballpit::tui::backend::{Counting, Lean};
 use ballpit::tui::canvas::Raster;
-use ballpit::tui::output::{Counting, Lean};
+use ballpit::tui::layout::{self, View};
 use ballpit::tui::readouts::Stats;
 use ballpit::tui::state::AppState;
 use ballpit::tui::theme::Palette;
@@ -355,7 +355,7 @@ impl TuiDraw {
             aspect: 2.0,
         };
         let raster = &mut self.raster;
-        self.term.draw(|f| app::draw(f, raster, &view)).unwrap();
+        self.term.draw(|f| layout::draw(f, raster, &view)).unwrap();
     }
 }
 

@@ -5,32 +5,25 @@
 //! Keys, resizes and signals arrive over a channel from the named threads
 //! `input` and `signals`, so the loop sleeps until a frame is due or
 //! something happens, and never busy-waits.
-pub mod app;
-pub mod canvas;
-mod caps;
-mod chart;
-mod escapes;
-mod guard;
-pub mod help;
-pub mod keys;
-mod latch;
+//!
+//! The files go by idea: `input/` (what comes in: keys, signals), `term/`
+//! (the terminal: set-up, the one gate for writes, the `output` thread,
+//! bytes and pacing), `view/` (what is drawn, into a buffer), and here the
+//! loop itself: `run` (engine, state, deadlines), `present` (a view of the
+//! state to one chunk on the wire), `state` (what the keys asked) and `msg`
+//! (what wakes the loop). The modules the tests and benches use are
+//! re-exported here, one path each.
+mod input;
 mod msg;
-pub mod output;
-mod pacing;
-pub mod parallelism;
 mod present;
-pub mod projection;
-mod quit;
-mod reader;
-pub mod readouts;
 mod run;
-mod signals;
 pub mod state;
-mod term_input;
-pub mod theme;
-pub mod threads;
-mod wrap;
-mod writer;
+mod term;
+mod view;
+
+pub use input::keys;
+pub use term::backend;
+pub use view::{canvas, help, layout, projection, readouts, theme, threads};
 
 pub use present::AfterFirstFrame;
 pub use run::{RunExtras, run, run_with};

@@ -1,6 +1,6 @@
 //! What wakes the frame loop: every thread of the app talks to it in one
 //! message type over one channel.
-use super::keys::Action;
+use super::input::keys::Action;
 
 /// What wakes the frame loop besides its own clock.
 #[derive(Clone, Debug, PartialEq)]

@@ -2,16 +2,16 @@
 //! the pacing, and turns a view of the state into one chunk on the wire. The
 //! frame loop (`run.rs`) owns the engine, the state and the deadlines, and
 //! asks the presenter to draw.
-use super::app::{self, View};
-use super::canvas::Raster;
-use super::escapes::STATUS_QUERY;
 use super::msg::Msg;
-use super::output::{Counting, Lean, Sink};
-use super::pacing::Pacer;
-use super::readouts::Stats;
 use super::state::AppState;
-use super::theme::Palette;
-use super::writer::Output;
+use super::term::backend::{Counting, Lean, Sink};
+use super::term::escapes::STATUS_QUERY;
+use super::term::pacing::Pacer;
+use super::term::writer::Output;
+use super::view::canvas::Raster;
+use super::view::layout::{self, View};
+use super::view::readouts::Stats;
+use super::view::theme::Palette;
 use crate::cpu::CpuReport;
 use crate::engine::Snapshot;
 use anyhow::anyhow;
@@ -158,9 +158,9 @@ impl Presenter {
         queue!(self.terminal.backend_mut(), BeginSynchronizedUpdate)?;
         let ascii = self.ascii;
         self.terminal.draw(|f| {
-            app::draw(f, raster, &view);
+            layout::draw(f, raster, &view);
             if ascii {
-                super::caps::asciify(f.buffer_mut());
+                super::term::caps::asciify(f.buffer_mut());
             }
         })?;
         let backend = self.terminal.backend_mut();

@@ -1,11 +1,12 @@
 //! The frame loop and its pacing.
-use super::guard::{self, Guard};
+use super::Options;
+use super::input::{reader, signals};
 use super::msg::Msg;
 use super::present::{AfterFirstFrame, Presenter, Scene};
-use super::readouts::Stats;
 use super::state::AppState;
-use super::theme::Palette;
-use super::{Options, reader, signals};
+use super::term::guard::{self, Guard};
+use super::view::readouts::Stats;
+use super::view::theme::Palette;
 use crate::cpu::{CpuReport, Sampler};
 use crate::engine::{Command, Engine, Rebuild, Settings, Snapshot};
 use crate::physics::World;
@@ -47,7 +48,7 @@ pub fn run_with(
     let env = |k: &str| std::env::var(k).ok();
     let palette = Palette::resolve(opts.color, &env);
     let detected = Palette::detect(&env);
-    let ascii = !super::caps::utf8_locale(&env);
+    let ascii = !super::term::caps::utf8_locale(&env);
     // crossterm drops colours itself under NO_COLOR; the resolved palette
     // already says whether there are any (a --color flag overrides NO_COLOR).
     crossterm::style::Colored::set_ansi_color_disabled(!palette.has_color());

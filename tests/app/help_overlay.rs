@@ -6,9 +6,9 @@ use crate::common::screen;
 use ballpit::cpu::{CpuReport, ThreadLoad, ThreadRole};
 use ballpit::engine::Engine;
 use ballpit::physics::{Sphere, World};
-use ballpit::tui::app::{self, MIN_HEIGHT, MIN_WIDTH, View};
 use ballpit::tui::canvas::Raster;
 use ballpit::tui::keys::TABLE;
+use ballpit::tui::layout::{self, MIN_HEIGHT, MIN_WIDTH, View};
 use ballpit::tui::readouts::Stats;
 use ballpit::tui::state::AppState;
 use ballpit::tui::theme::Palette;
@@ -49,7 +49,8 @@ fn screen(w: u16, h: u16) -> Vec<Vec<char>> {
         aspect: 2.0,
     };
     let mut t = Terminal::new(TestBackend::new(w, h)).unwrap();
-    t.draw(|f| app::draw(f, &mut Raster::new(), &view)).unwrap();
+    t.draw(|f| layout::draw(f, &mut Raster::new(), &view))
+        .unwrap();
     let buf = t.backend().buffer();
     (0..h)
         .map(|y| {

@@ -9,9 +9,9 @@ use crate::common::screen;
 use ballpit::cpu::{CpuReport, ThreadLoad, ThreadRole};
 use ballpit::engine::{Command, Engine, MAX_THREADS, Settings, Snapshot, Threading};
 use ballpit::physics::{ModelKind, Sphere, World, edit};
-use ballpit::tui::app::{self, View};
 use ballpit::tui::canvas::{DrawStyle, Raster};
 use ballpit::tui::keys::TABLE;
+use ballpit::tui::layout::{self, View};
 use ballpit::tui::readouts::{NOTICE_ROWS, Readouts, Stats};
 use ballpit::tui::state::{AppState, FPS_STEPS, MAX_KEY_COUNT, MAX_TICK, MIN_RADIUS};
 use ballpit::tui::theme::Palette;
@@ -283,7 +283,7 @@ fn shown(
     (w, h): (u16, u16),
 ) -> (Vec<String>, Rect, String) {
     let notice = readouts(st, snap).notice();
-    let a = app::areas_with(Rect::new(0, 0, w, h), r, notice.as_deref()).unwrap();
+    let a = layout::areas_with(Rect::new(0, 0, w, h), r, notice.as_deref()).unwrap();
     let view = View {
         state: st,
         snap,
@@ -293,7 +293,8 @@ fn shown(
         aspect: 2.0,
     };
     let mut t = Terminal::new(TestBackend::new(w, h)).unwrap();
-    t.draw(|f| app::draw(f, &mut Raster::new(), &view)).unwrap();
+    t.draw(|f| layout::draw(f, &mut Raster::new(), &view))
+        .unwrap();
     let inner = Rect {
         x: a.readouts.x + 1,
         y: a.readouts.y + 1,
@@ -361,12 +362,12 @@ fn a_notice_longer_than_the_kept_rows_takes_the_threads_spare_rows() {
             // Every thread still shown: the rows come from blank ones, or
             // from a layout of the threads that still shows them all.
             assert!(screen.contains("other procs"), "{what}");
-            let threads = app::areas_with(Rect::new(0, 0, size.0, size.1), r, Some(&text))
+            let threads = layout::areas_with(Rect::new(0, 0, size.0, size.1), r, Some(&text))
                 .unwrap()
                 .threads;
             // The least rows that show every thread (a cell each, or the
             // rows they had anyway when cells must be shared).
-            let before = app::areas(Rect::new(0, 0, size.0, size.1), r)
+            let before = layout::areas(Rect::new(0, 0, size.0, size.1), r)
                 .unwrap()
                 .threads;
             let least = threads::full_height(r)

@@ -237,7 +237,7 @@ fn a_long_notice_wraps_instead_of_being_cut() {
     let notice = "count limit: no free space for more spheres (1234 of 2000)";
     st.notice = Some(notice.into());
     let r = report_for(Threading::Pool, 2);
-    let small = ballpit::tui::app::areas(ratatui::layout::Rect::new(0, 0, 80, 24), &r).unwrap();
+    let small = ballpit::tui::layout::areas(ratatui::layout::Rect::new(0, 0, 80, 24), &r).unwrap();
     for (t, x0) in [
         (readouts(&st, &ran(&st), Palette::C16), 0),
         (screen(80, 24, &st, &r), small.readouts.x),

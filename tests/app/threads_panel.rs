@@ -5,7 +5,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a failed unwrap is a failed test
 use crate::common::screen::{rows, settings};
 use ballpit::cpu::{CpuReport, ThreadLoad, ThreadRole};
-use ballpit::tui::app;
+use ballpit::tui::layout;
 use ballpit::tui::theme::Palette;
 use ballpit::tui::threads::{self, Layout, Threads};
 use ratatui::Terminal;
@@ -53,7 +53,7 @@ fn order_percent_base_and_pool_total_at_three_sizes_and_four_pools() {
     for (w, h) in [(80u16, 24u16), (120, 40), (200, 60)] {
         for pool in [1usize, 2, 64, 256] {
             let r = report(pool);
-            let area = app::areas(Rect::new(0, 0, w, h), &r).unwrap().threads;
+            let area = layout::areas(Rect::new(0, 0, w, h), &r).unwrap().threads;
             let mut t = Terminal::new(TestBackend::new(area.width, area.height)).unwrap();
             let panel = Threads {
                 report: &r,
@@ -294,7 +294,7 @@ fn the_pool_line_gives_the_parallelism_within_the_panel() {
                 Bound::Cores
             };
             snap.pool_busy = Some(busy(2, pool, bound));
-            let area = app::areas(Rect::new(0, 0, w, h), &r).unwrap().threads;
+            let area = layout::areas(Rect::new(0, 0, w, h), &r).unwrap().threads;
             let mut t = Terminal::new(TestBackend::new(area.width, area.height)).unwrap();
             t.draw(|f| {
                 f.render_widget(

@@ -5,9 +5,9 @@ use crate::common::screen::{rows, settings, text};
 use ballpit::cpu::{CpuReport, ThreadLoad, ThreadRole};
 use ballpit::engine::{Engine, Settings, Snapshot, Threading};
 use ballpit::physics::{Sphere, World};
-use ballpit::tui::app::{self, View};
 use ballpit::tui::canvas::{DrawStyle, Raster, Scene};
 use ballpit::tui::help::{HelpBar, HelpOverlay};
+use ballpit::tui::layout::{self, View};
 use ballpit::tui::projection::Camera;
 use ballpit::tui::readouts::Stats;
 use ballpit::tui::state::AppState;
@@ -219,9 +219,9 @@ fn whole_screen_and_the_too_small_message() {
         aspect: 2.0,
     };
     let mut raster = Raster::new();
-    let t = render(120, 30, |f| app::draw(f, &mut raster, &view));
+    let t = render(120, 30, |f| layout::draw(f, &mut raster, &view));
     insta::assert_snapshot!("whole_screen", t.backend());
-    let t = render(60, 12, |f| app::draw(f, &mut raster, &view));
+    let t = render(60, 12, |f| layout::draw(f, &mut raster, &view));
     insta::assert_snapshot!("too_small", t.backend());
 }
 
@@ -295,7 +295,7 @@ pub(crate) fn screen_with(
         aspect: 2.0,
     };
     let mut raster = Raster::new();
-    render(w, h, |f| app::draw(f, &mut raster, &view))
+    render(w, h, |f| layout::draw(f, &mut raster, &view))
 }
 
 pub(crate) fn mode_state(mode: Threading, pool: usize) -> AppState {
@@ -346,7 +346,7 @@ fn sixty_four_pool_threads_at_80x24_are_a_grid_with_min_mean_max() {
 
 #[test]
 fn any_size_from_the_minimum_and_any_thread_count_shows_every_thread() {
-    use ballpit::tui::app::{MIN_HEIGHT, MIN_WIDTH};
+    use ballpit::tui::layout::{MIN_HEIGHT, MIN_WIDTH};
     for pool in [1, 3, 9, 33, 100, 256] {
         let r = report_for(Threading::Pool, pool);
         let mut st = mode_state(Threading::Pool, pool);
@@ -362,7 +362,7 @@ fn any_size_from_the_minimum_and_any_thread_count_shows_every_thread() {
 
 #[test]
 fn below_the_minimum_a_message_and_no_panic_at_0x0_or_1x1() {
-    use ballpit::tui::app::{MIN_HEIGHT, MIN_WIDTH};
+    use ballpit::tui::layout::{MIN_HEIGHT, MIN_WIDTH};
     let r = report_for(Threading::Pool, 2);
     let st = state();
     for (w, h) in [

@@ -6,11 +6,11 @@ use super::canvas::{Raster, Scene};
 use super::chart::CpuChart;
 use super::help::{HelpBar, HelpOverlay};
 use super::readouts::{self, Readouts, Stats};
-use super::state::AppState;
 use super::theme::Palette;
 use super::threads::{self, Threads};
 use crate::cpu::CpuReport;
 use crate::engine::Snapshot;
+use crate::tui::state::AppState;
 use ratatui::Frame;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::text::Line;
@@ -100,7 +100,7 @@ pub fn draw(frame: &mut Frame, raster: &mut Raster, v: &View) {
     };
     let Some(a) = areas_with(area, v.report, panel.notice().as_deref()) else {
         let msg: Vec<Line> =
-            super::caps::size_message(area.width, area.height, (MIN_WIDTH, MIN_HEIGHT))
+            crate::tui::term::caps::size_message(area.width, area.height, (MIN_WIDTH, MIN_HEIGHT))
                 .into_iter()
                 .map(Line::from)
                 .collect();

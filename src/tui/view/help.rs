@@ -1,7 +1,7 @@
 //! The key bar (always there) and the `?` overlay (every key, explained),
 //! both read from `keys::TABLE`.
-use super::keys::{self, TABLE};
 use super::theme::Palette;
+use crate::tui::input::keys::{self, TABLE};
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
 use ratatui::text::{Line, Span};

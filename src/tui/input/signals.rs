@@ -1,8 +1,8 @@
 //! The `signals` thread: resizes, job control and the signals that end the
 //! process. Every one of them that can be caught puts the terminal back
 //! first (docs/terminal-io.md, Signals).
-use super::guard;
-use super::msg::Msg;
+use crate::tui::msg::Msg;
+use crate::tui::term::guard;
 use crossbeam_channel::Sender;
 use signal_hook::consts::{
     SIGALRM, SIGCONT, SIGHUP, SIGINT, SIGPIPE, SIGPROF, SIGQUIT, SIGTERM, SIGTSTP, SIGUSR1,

@@ -66,7 +66,7 @@ impl Palette {
             Palette::True
         } else if term.contains("256color") {
             Palette::C256
-        } else if super::caps::monochrome(&term) {
+        } else if crate::tui::term::caps::monochrome(&term) {
             Palette::Mono
         } else {
             Palette::C16
@@ -143,7 +143,35 @@ impl Palette {
     pub fn key(self) -> Style {
         Style::new().add_modifier(Modifier::REVERSED)
     }
+
+    /// A thread's load: red when near full, yellow past half, green below.
+    pub fn load(self, percent: f64) -> Style {
+        if !self.has_color() {
+            return Style::new();
+        }
+        let c = if percent >= 85.0 {
+            Color::LightRed
+        } else if percent >= 50.0 {
+            Color::Yellow
+        } else {
+            Color::Green
+        };
+        Style::new().fg(c)
+    }
 }
+
+/// The CPU chart's lines: eight hues a 16-colour terminal tells apart (no
+/// dark twin of a light one).
+pub const LINE_COLOURS: [Color; 8] = [
+    Color::LightRed,
+    Color::LightGreen,
+    Color::LightYellow,
+    Color::LightBlue,
+    Color::LightMagenta,
+    Color::LightCyan,
+    Color::White,
+    Color::Gray,
+];
 
 /// What a sphere's colour says.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

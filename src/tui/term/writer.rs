@@ -3,7 +3,7 @@
 //! blocks the thread that answers them. It writes through the terminal's
 //! latch ([`latch::gated_stdout`]), so nothing lands after a restore.
 use super::latch;
-use super::msg::Msg;
+use crate::tui::msg::Msg;
 use crossbeam_channel::Sender;
 use std::io;
 use std::thread;

@@ -1,10 +1,10 @@
 //! Raw mode and the panic hook: the terminal is set up once and put back on
 //! every way out (normal return, error, panic in any thread, a signal), and
 //! around a stop (job control). Writes go through [`super::latch`]; the quit
-//! watchdog is [`super::quit`], the signal thread [`super::signals`].
+//! watchdog is [`crate::tui::input::quit`], the signal thread [`crate::tui::input::signals`].
 use super::escapes::{PASTE_OFF, PASTE_ON, RESET_ATTRIBUTES};
 use super::latch::TERMINAL;
-use super::msg::Msg;
+use crate::tui::msg::Msg;
 use crossbeam_channel::Sender;
 use crossterm::{cursor, execute, queue, terminal};
 use parking_lot::{Condvar, Mutex};

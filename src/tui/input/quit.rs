@@ -1,6 +1,6 @@
 //! The quit watchdog: a quit key gives the frame loop a grace period to end
 //! by itself, then the process is ended for it, the terminal put back.
-use super::guard::restore;
+use crate::tui::term::guard::restore;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread;
 use std::time::Duration;

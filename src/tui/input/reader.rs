@@ -5,11 +5,11 @@
 //! input, hang-up and read errors mean the terminal is gone: the thread says
 //! so and stops, without spinning.
 use super::keys::{self, Action};
-use super::latch::TERMINAL;
-use super::msg::Msg;
 use super::quit;
 use super::signals;
 use super::term_input::{Input, Parser};
+use crate::tui::msg::Msg;
+use crate::tui::term::latch::TERMINAL;
 use crossbeam_channel::Sender;
 use rustix::event::{PollFd, PollFlags, Timespec};
 use std::io;

@@ -12,7 +12,7 @@ use crate::cpu::history;
 use crate::cpu::{CpuReport, ThreadLoad, ThreadRole, order_key};
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
-use ratatui::style::{Color, Style};
+use ratatui::style::Style;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Paragraph, Widget};
 
@@ -194,17 +194,7 @@ pub enum Layout {
 
 impl Threads<'_> {
     fn load_style(&self, percent: f64) -> Style {
-        if !self.palette.has_color() {
-            return Style::new();
-        }
-        let c = if percent >= 85.0 {
-            Color::LightRed
-        } else if percent >= 50.0 {
-            Color::Yellow
-        } else {
-            Color::Green
-        };
-        Style::new().fg(c)
+        self.palette.load(percent)
     }
 
     /// `threads` busiest first when sorting by CPU (ties in the fixed order).

@@ -3,12 +3,12 @@
 //! from `main` to `physics` on `t` is a picture. With many threads the
 //! numbered group (`pool-N`) is drawn as its mean and its max, and the
 //! legend says so. The axes are in percent of one core and seconds.
-use super::theme::Palette;
+use super::theme::{LINE_COLOURS, Palette};
 use super::threads::{nice_ceiling, ordered, split_group};
 use crate::cpu::{CpuReport, history};
 use ratatui::buffer::Buffer;
 use ratatui::layout::{Constraint, Layout, Rect};
-use ratatui::style::{Color, Style};
+use ratatui::style::Style;
 use ratatui::symbols::Marker;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Axis, Block, Chart, Dataset, GraphType, Paragraph, Widget};
@@ -16,17 +16,6 @@ use ratatui::widgets::{Axis, Block, Chart, Dataset, GraphType, Paragraph, Widget
 /// More lines than this and the numbered group is drawn as mean and max.
 pub const MAX_LINES: usize = 8;
 
-/// Eight hues a 16-colour terminal tells apart (no dark twin of a light one).
-const COLOURS: [Color; 8] = [
-    Color::LightRed,
-    Color::LightGreen,
-    Color::LightYellow,
-    Color::LightBlue,
-    Color::LightMagenta,
-    Color::LightCyan,
-    Color::White,
-    Color::Gray,
-];
 /// Without colour, lines are told apart by their marks, and the legend by
 /// the glyph each draws with.
 const MARKS: [(Marker, &str); 4] = [
@@ -136,7 +125,7 @@ impl CpuChart<'_> {
     /// How many lines this palette can draw with no two alike.
     pub fn styles(&self) -> usize {
         if self.palette.has_color() {
-            COLOURS.len() * MARKS.len()
+            LINE_COLOURS.len() * MARKS.len()
         } else {
             MARKS.len()
         }
@@ -146,8 +135,12 @@ impl CpuChart<'_> {
     /// the next mark; without colour, a mark each.
     pub fn style(&self, i: usize) -> (Marker, &'static str, Style) {
         if self.palette.has_color() {
-            let (marker, glyph) = MARKS[(i / COLOURS.len()) % MARKS.len()];
-            (marker, glyph, Style::new().fg(COLOURS[i % COLOURS.len()]))
+            let (marker, glyph) = MARKS[(i / LINE_COLOURS.len()) % MARKS.len()];
+            (
+                marker,
+                glyph,
+                Style::new().fg(LINE_COLOURS[i % LINE_COLOURS.len()]),
+            )
         } else {
             let (marker, glyph) = MARKS[i % MARKS.len()];
             (marker, glyph, Style::new())

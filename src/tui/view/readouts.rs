@@ -1,11 +1,11 @@
 //! The readouts panel: every figure as text in a fixed place, so values
 //! change without the layout moving.
-use super::state::{AppState, representative_radius};
 use super::theme::Palette;
 use super::wrap::wrap;
 use crate::engine::{Settings, Snapshot, Threading};
 use crate::physics::ModelKind;
 use crate::physics::auto::Choice;
+use crate::tui::state::{AppState, representative_radius};
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
 use ratatui::text::{Line, Span};
