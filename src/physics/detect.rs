@@ -51,7 +51,7 @@ impl Detection {
         self.walls.ensure(blocks);
         self.walls.truncate(blocks);
         let slots = &self.walls;
-        let limit = self.pair_limit.unwrap_or(usize::MAX);
+        let limit = self.pair_limit;
         let find_walls = |exec: &dyn Exec| {
             for_each_block_of(exec, blocks, work_ns(n, NS_PER_WALL_TEST), &|b| {
                 let mut v = slots[b].lock();

@@ -35,9 +35,10 @@ pub trait Exec: Sync {
             }
         });
     }
-    /// Most cores the executor's lanes can run on at once (the machine's).
+    /// Most cores the executor's lanes can run on at once (the machine's;
+    /// by default each lane has one).
     fn cores(&self) -> usize {
-        usize::MAX
+        self.lanes()
     }
     /// Nanoseconds of predicted work a lane must have before another is
     /// woken; an executor that only checks the cut (tests) may say 1 to get

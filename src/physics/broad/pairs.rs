@@ -121,8 +121,8 @@ impl Grid {
     }
 
     /// As [`Grid::pairs`], but stops once more than `limit` pairs are
-    /// found (a step's work budget); returns false then, with only some of
-    /// them in `out`. Every unit runs to its end unless the running total
+    /// found (a step's work budget; `None`: no limit); returns false then,
+    /// with only some of them in `out`. Every unit runs to its end unless the running total
     /// is over `limit`, so the answer is "the pairs number more than
     /// `limit`", whatever the lanes and their timing.
     pub fn pairs_within<K: Fn(u32, u32) -> bool + Sync>(
@@ -130,12 +130,12 @@ impl Grid {
         exec: &dyn Exec,
         keep: &K,
         out: &mut Vec<Pair>,
-        limit: usize,
+        limit: Option<usize>,
     ) -> bool {
-        if limit == usize::MAX {
+        let Some(limit) = limit else {
             self.pairs(exec, keep, out);
             return true;
-        }
+        };
         out.clear();
         let (all, units) = self.scan_within::<true, K>(exec, keep, limit);
         if all {

@@ -19,7 +19,7 @@ impl Exact {
     /// a crossing to prefetch for it part-way through
     /// ([`prefetch_next_crossing`]).
     #[inline(always)]
-    pub(super) fn prefetch_ahead(&self, i: Label, ev: Event) -> usize {
+    pub(super) fn prefetch_ahead(&self, i: Label, ev: Event) -> Option<Label> {
         match (ev.kind(), &self.broad) {
             (Kind::Cross, Broad::Cells(cells)) => {
                 cells.prefetch_cross(i, ev.mask());
@@ -37,8 +37,10 @@ impl Exact {
             _ => {}
         }
         let next = self.queue.runner_up();
-        self.prefetch_records(next);
-        next
+        if let Some(k) = next {
+            self.prefetch_records(k);
+        }
+        next.map(Label::at)
     }
 
     /// Start loading what predicting `i` reads first: the bodies in its
@@ -90,11 +92,12 @@ impl Exact {
 /// read. (In a contact or a wall event it has not arrived in time:
 /// docs/perf-log.md.)
 #[inline(always)]
-pub(super) fn prefetch_next_crossing(cells: &CellGrid, holds: &[Queued], next: usize) {
-    if let Some(&q) = holds.get(next)
+pub(super) fn prefetch_next_crossing(cells: &CellGrid, holds: &[Queued], next: Option<Label>) {
+    if let Some(next) = next
+        && let Some(&q) = holds.get(next.index())
         && q.is_broad()
         && q.event().kind() == Kind::Cross
     {
-        cells.prefetch_cross(Label::at(next), q.event().mask());
+        cells.prefetch_cross(next, q.event().mask());
     }
 }

@@ -180,14 +180,14 @@ impl EventQueue for EightWay {
     /// 64 or fewer). Any sphere, or a padding leaf, when no other event
     /// is finite.
     #[inline]
-    fn runner_up(&self) -> usize {
+    fn runner_up(&self) -> Option<usize> {
         let root = self.levels - 1;
         let inner = self.start[1];
         // The lowest levels are skipped: their groups are cold, and the next
         // event is among the winner's 63 nearest leaves only 63 times in N.
         let from = if root > 2 { 2 } else { 0 };
         let mut a = self.ids[self.start[root] - inner].0[0] as usize / WAYS.pow(from as u32);
-        let (mut best, mut who) = (u64::MAX, usize::MAX);
+        let (mut best, mut who) = (u64::MAX, None);
         for l in from..root {
             let (g, lane) = (a / WAYS, a % WAYS);
             let mut keys = self.keys[self.start[l % MAX_LEVELS] + g];
@@ -195,11 +195,11 @@ impl EventQueue for EightWay {
             let (k, at) = least(&keys);
             if k < best {
                 best = k;
-                who = if l == 0 {
+                who = Some(if l == 0 {
                     g * WAYS + at
                 } else {
                     self.ids[self.start[l % MAX_LEVELS] - inner + g].0[at] as usize
-                };
+                });
             }
             a = g;
         }
@@ -290,8 +290,8 @@ mod tests {
                     .filter(|&k| apart(k))
                     .map(|k| times[k])
                     .fold(f64::INFINITY, f64::min);
-                let r = q.runner_up();
                 if next.is_finite() {
+                    let r = q.runner_up().expect("another finite event has a runner-up");
                     assert!(r < n, "{n} spheres: {r}");
                     assert_eq!(q.time_of(r), next, "{n} spheres");
                 }

@@ -288,7 +288,7 @@ impl Exact {
     /// Cell mode: sphere `i` crosses into the next cell as `mask` says. Its
     /// pending event still holds unless its partner has moved on; only the
     /// layer of cells the crossing brings next to it needs checking.
-    fn cross<const PF: bool>(&mut self, i: Label, mask: u8, next: usize) {
+    fn cross<const PF: bool>(&mut self, i: Label, mask: u8, next: Option<Label>) {
         let Broad::Cells(cells) = &mut self.broad else {
             // Only cells have crossings; any other broad phase predicts anew.
             self.schedule::<PF>(i);
@@ -363,11 +363,7 @@ impl Exact {
             done += 1;
             let ev = self.queued(i);
             // The sphere whose event is likely next (none without prefetching).
-            let next = if PF {
-                self.prefetch_ahead(i, ev)
-            } else {
-                usize::MAX
-            };
+            let next = if PF { self.prefetch_ahead(i, ev) } else { None };
             self.bodies[i].advance(t);
             match ev.kind() {
                 Kind::Pair => {

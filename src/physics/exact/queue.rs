@@ -33,10 +33,11 @@ pub trait EventQueue: Default {
     /// The earliest pending event: time and sphere (time infinite if none).
     /// Mutable, so a queue may sort lazily.
     fn peek(&mut self) -> (f64, usize);
-    /// The sphere whose event is likely next after [`Self::peek`]'s, or
-    /// any index at all: a hint for loading its records early.
-    fn runner_up(&self) -> usize {
-        usize::MAX
+    /// The sphere whose event is likely next after [`Self::peek`]'s (or
+    /// any sphere): a hint for loading its records early; `None` when the
+    /// queue gives no hint.
+    fn runner_up(&self) -> Option<usize> {
+        None
     }
     /// Start loading what [`Self::update`] of sphere `i` will read first.
     fn prefetch(&self, _i: usize) {}
