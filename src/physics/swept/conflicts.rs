@@ -84,11 +84,9 @@ impl Finished {
         self.grew.push(false);
     }
 
-    /// Takes a block's chunk in, at its size (it grew by doubling); returns
+    /// Takes a block's chunk in (its runs shrank it to its size); returns
     /// its number, for [`Finished::set`].
-    pub fn keep(&mut self, mut chunk: Chunk) -> u32 {
-        chunk.members.shrink_to_fit();
-        chunk.turns.shrink_to_fit();
+    pub fn keep(&mut self, chunk: Chunk) -> u32 {
         self.chunks.push(chunk);
         (self.chunks.len() - 1) as u32
     }

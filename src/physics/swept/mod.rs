@@ -26,6 +26,7 @@ mod group;
 mod knobs;
 mod partition;
 mod parts;
+mod results;
 mod rounds;
 mod stats;
 
@@ -41,6 +42,7 @@ use super::world::World;
 use cluster::Coarse;
 use glam::DVec3;
 pub use parts::{ADDED_PAIRS, parts};
+use results::{Totals, take_results};
 use rounds::Rounds;
 pub use stats::RoundStats;
 
@@ -74,6 +76,8 @@ pub struct Swept {
     /// Per block of candidate pairs: the deepest overlap among them.
     overlap: PerBlock<f64>,
     rounds: Rounds,
+    /// Per block of results taken in parallel, their totals.
+    totals: PerBlock<Totals>,
     /// The last step's `rounds` stats, over all its parts.
     step_stats: RoundStats,
     /// Parts the last step was cut into.
@@ -261,16 +265,8 @@ impl Swept {
         // run's end, and the counters are summed in sphere order: the same
         // bits on any lanes and however the clusters fell.
         fly_straight(exec, &mut world.spheres, dt);
-        let c = &mut world.counters;
-        let mut capped = None;
-        for (m, cap) in self.rounds.results() {
-            let s = &mut world.spheres[m.id as usize];
-            (s.pos, s.vel) = (m.pos, m.vel);
-            c.wall_momentum += m.wall_momentum;
-            c.sphere_collisions += u64::from(m.pair_hits);
-            c.wall_collisions += u64::from(m.wall_hits);
-            capped = capped.max(cap);
-        }
+        let (spheres, c) = (&mut world.spheres, &mut world.counters);
+        let capped = take_results(exec, &self.rounds, spheres, c, &mut self.totals);
         PartEnd::Ran(capped)
     }
 

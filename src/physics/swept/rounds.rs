@@ -92,13 +92,21 @@ impl Rounds {
     /// in sphere order (so totals summed in this order are the serial
     /// loop's to the bit, however the clusters fell).
     pub fn results(&self) -> impl Iterator<Item = (&Member, Option<Coarse>)> {
-        self.in_order.iter().map(|&s| {
-            let s = s.index();
-            let Some((m, _)) = self.fin.record(s) else {
-                unreachable!("every involved sphere finished");
-            };
-            (m, self.fin.capped[s])
-        })
+        (0..self.involved()).map(|k| self.result(k))
+    }
+
+    /// How many spheres had events in the last `run`.
+    pub fn involved(&self) -> usize {
+        self.in_order.len()
+    }
+
+    /// The `k`-th of [`Rounds::results`].
+    pub fn result(&self, k: usize) -> (&Member, Option<Coarse>) {
+        let s = self.in_order[k].index();
+        let Some((m, _)) = self.fin.record(s) else {
+            unreachable!("every involved sphere finished");
+        };
+        (m, self.fin.capped[s])
     }
 
     /// Runs the events of a step: `meets` are the pairs whose straight paths
@@ -290,6 +298,10 @@ impl Rounds {
                 let len = (out.chunk.members.len() - before) as u32;
                 out.done.push((run.capped, len, run.work));
             }
+            // Kept at its size (room was reserved by estimate): the copy is
+            // made here, on the block's lane, not where the chunks are taken.
+            out.chunk.members.shrink_to_fit();
+            out.chunk.turns.shrink_to_fit();
         });
     }
 
@@ -343,6 +355,8 @@ impl Rounds {
         let mut root = Slot::NONE;
         let mut twice = false;
         let mut first = None;
+        // Whether `root` is the run's own cluster's.
+        let mut own_root = false;
         for at in at {
             let Some((m, _)) = self.fin.record_in(c, at) else {
                 unreachable!("a chunk holds the members its runs wrote");
@@ -355,15 +369,23 @@ impl Rounds {
                 Slot::NONE => self.add_slot(id),
                 s => s,
             };
-            twice |= s.index() >= known && self.fin.ran[s.index()] == round;
+            let joined = s.index() >= known;
+            twice |= joined && self.fin.ran[s.index()] == round;
             self.fin.set(s.index(), c, at);
             self.fin.capped[s.index()] = capped;
             self.fin.ran[s.index()] = round;
+            // A slot from before this round is of the run's own cluster
+            // (the run only notes those of others): it has the root already.
             root = if root.is_none() {
                 self.part.find(s)
+            } else if joined {
+                self.part.link(root, s)
+            } else if own_root {
+                root
             } else {
                 self.part.link(root, s)
             };
+            own_root |= !joined;
         }
         match (twice, first) {
             (true, Some(first)) => {
