@@ -51,7 +51,7 @@ pub use stats::RoundStats;
 const REACH_SLACK: f64 = 1.0 + 1e-9;
 /// Candidate pairs per parallel block when sorting them into meeting and
 /// merely near.
-const PAIR_BLOCK: usize = 4096;
+const PAIR_BLOCK: usize = 1024;
 /// Predicted nanoseconds of sorting one near pair (docs/threading.md).
 const NS_PER_PAIR_SORT: usize = 70;
 /// The work budget of one step, in pair checks (pairs detection finds,
