@@ -48,6 +48,27 @@ impl PartialEq for World {
     }
 }
 
+/// Whether a world is the one a model last saw, without a pass over the
+/// spheres: its edit generation (every edit from outside a model calls
+/// [`World::touch`]), its time (a step by any model moves it), its box and
+/// its count. The one way every model asks "has the world changed?".
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Stamp {
+    generation: u64,
+    time: u64,
+    size: u64,
+    count: usize,
+}
+
+impl Stamp {
+    /// The stamp of the scene however far it ran: equal for two worlds
+    /// that differ only by steps taken since the last edit.
+    #[must_use]
+    pub fn scene(self) -> Stamp {
+        Stamp { time: 0, ..self }
+    }
+}
+
 impl World {
     pub fn new(size: f64, spheres: Vec<Sphere>) -> Self {
         World {
@@ -72,6 +93,17 @@ impl World {
     /// made apart (clones share it until one of them is touched).
     pub fn generation(&self) -> u64 {
         self.generation
+    }
+
+    /// What says whether this is the world a model last saw.
+    #[must_use]
+    pub fn stamp(&self) -> Stamp {
+        Stamp {
+            generation: self.generation,
+            time: self.time.to_bits(),
+            size: self.size.to_bits(),
+            count: self.spheres.len(),
+        }
     }
 
     pub fn kinetic_energy(&self) -> f64 {
@@ -122,4 +154,35 @@ impl World {
 #[inline]
 pub fn escapes(s: &Sphere, size: f64, tol: f64) -> bool {
     (0..3).any(|k| s.pos[k] < s.radius - tol || s.pos[k] > size - s.radius + tol)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::World;
+    use crate::physics::sphere::Sphere;
+    use glam::DVec3;
+
+    fn world() -> World {
+        let s = Sphere::new(DVec3::splat(0.5), DVec3::X, 0.1);
+        World::new(1.0, vec![s])
+    }
+
+    #[test]
+    fn the_stamp_changes_with_an_edit_a_step_and_the_count() {
+        let w = world();
+        let before = w.stamp();
+        assert_eq!(w.clone().stamp(), before, "a clone is the same world");
+        let mut edited = w.clone();
+        edited.touch();
+        assert_ne!(edited.stamp(), before);
+        let mut ran = w.clone();
+        ran.time += 1.0 / 60.0;
+        assert_ne!(ran.stamp(), before);
+        assert_eq!(ran.stamp().scene(), before.scene(), "the same scene, later");
+        assert_ne!(edited.stamp().scene(), before.scene());
+        let mut more = w.clone();
+        more.spheres.push(more.spheres[0]);
+        assert_ne!(more.stamp().scene(), before.scene());
+        assert_ne!(world().stamp(), before, "worlds made apart differ");
+    }
 }

@@ -13,7 +13,7 @@ pub use choose::{
 use super::exec::Exec;
 use super::kind::ModelKind;
 use super::model::Model;
-use super::world::World;
+use super::world::{Stamp, World};
 
 /// How strict the models let in are: 0 all, 1 `swept` and `exact`, 2 `exact`.
 fn level(m: ModelKind) -> u8 {
@@ -24,9 +24,9 @@ fn level(m: ModelKind) -> u8 {
     }
 }
 
-/// What the choice was made for: the spheres' edit generation, their
-/// count, `dt`, the steps per frame and whether overlaps are read.
-type Key = (u64, usize, u64, u64, bool);
+/// What the choice was made for: the scene (as edited, however far it
+/// ran), `dt`, the steps per frame and whether overlaps are read.
+type Key = (Stamp, u64, u64, bool);
 
 pub struct Auto {
     tol: Tolerance,
@@ -195,13 +195,7 @@ impl Model for Auto {
     fn advance(&mut self, world: &mut World, dt: f64, steps: u64, exec: &dyn Exec) {
         self.readouts = self.read_since;
         self.read_since = false;
-        let key = (
-            world.generation(),
-            world.spheres.len(),
-            dt.to_bits(),
-            steps,
-            self.readouts,
-        );
+        let key = (world.stamp().scene(), dt.to_bits(), steps, self.readouts);
         if self.key != Some(key) {
             self.key = Some(key);
             self.floor = 0;

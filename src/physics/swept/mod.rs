@@ -38,7 +38,7 @@ use super::flight::{fly, fly_straight};
 use super::model::{Model, ModelKind};
 use super::sphere::{Sphere, overlap_rel};
 use super::wide::wide;
-use super::world::World;
+use super::world::{Stamp, World};
 use cluster::Coarse;
 use glam::DVec3;
 pub use parts::{ADDED_PAIRS, parts};
@@ -90,11 +90,11 @@ pub struct Swept {
 
 /// A detection made ahead of its step (when the engine asked for the
 /// overlap of the world a frame ended with): valid for the world with this
-/// key and this `dt` only.
+/// stamp and this `dt` only.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Ahead {
     dt: f64,
-    key: WorldKey,
+    stamp: Stamp,
     overlap: f64,
     /// The detection found more pairs than a step's budget allows.
     overran: bool,
@@ -107,26 +107,6 @@ enum PartEnd {
     /// Its detection alone found more pairs than the budget left: the world
     /// is as it was.
     Overran,
-}
-
-/// What a detection made ahead is valid for: a world of this generation
-/// (bumped by every edit from outside, `World::touch`), at this time (a
-/// step by any model moves it), with this many spheres.
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct WorldKey {
-    generation: u64,
-    time: u64,
-    count: usize,
-}
-
-impl WorldKey {
-    fn of(world: &World) -> WorldKey {
-        WorldKey {
-            generation: world.generation(),
-            time: world.time.to_bits(),
-            count: world.spheres.len(),
-        }
-    }
 }
 
 /// The ball a sphere on a straight path stays in during the step: centred
@@ -183,10 +163,10 @@ impl Model for Swept {
     fn max_overlap_rel(&mut self, world: &World, dt: f64, exec: &dyn Exec) -> Option<f64> {
         // The detection of the next step's first part.
         let dt = dt / f64::from(self.parts_of(world, dt));
-        let key = WorldKey::of(world);
+        let stamp = world.stamp();
         if let Some(a) = self.ahead
             && a.dt == dt
-            && a.key == key
+            && a.stamp == stamp
         {
             return (!a.overran).then_some(a.overlap);
         }
@@ -195,7 +175,7 @@ impl Model for Swept {
         let overran = self.detect.overran;
         self.ahead = Some(Ahead {
             dt,
-            key,
+            stamp,
             overlap,
             overran,
         });
@@ -237,7 +217,7 @@ impl Swept {
     fn step(&mut self, world: &mut World, dt: f64, exec: &dyn Exec, left: &mut u64) -> PartEnd {
         let size = world.size;
         let ready = self.ahead.take().filter(|a| {
-            a.dt == dt && a.key == WorldKey::of(world) && (a.overran || self.pairs_fit(*left))
+            a.dt == dt && a.stamp == world.stamp() && (a.overran || self.pairs_fit(*left))
         });
         let overran = if let Some(a) = ready {
             a.overran
