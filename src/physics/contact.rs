@@ -61,14 +61,21 @@ pub fn reflect_walls(s: &mut Sphere, mask: [bool; 3]) -> (f64, u64) {
     let mut impulse = 0.0;
     let mut hits = 0;
     for (k, &hit) in mask.iter().enumerate() {
-        let v = s.vel[k];
-        if hit && v != 0.0 {
-            s.vel[k] = -v;
-            impulse += 2.0 * s.mass * v.abs();
+        if hit && s.vel[k] != 0.0 {
+            impulse += reflect_axis(s, k);
             hits += 1;
         }
     }
     (impulse, hits)
+}
+
+/// Reflect the velocity along axis `k` off a wall: the one reflection of
+/// every model. Returns the momentum given to the wall, `2 m |v_k|`.
+#[inline]
+pub fn reflect_axis(s: &mut Sphere, k: usize) -> f64 {
+    let v = s.vel[k];
+    s.vel[k] = -v;
+    2.0 * s.mass * v.abs()
 }
 
 /// Elastic impulse between two spheres, only if they approach along the line

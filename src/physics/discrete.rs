@@ -4,7 +4,7 @@
 //! Wall contacts mirror the position back inside (no energy is added: only
 //! velocities carry energy). Overlaps are found on the moved positions,
 //! before the wall mirror.
-use super::contact::resolve_pair;
+use super::contact::{reflect_axis, resolve_pair};
 use super::detect::Detection;
 use super::exec::Exec;
 use super::flight::fly_straight;
@@ -104,8 +104,7 @@ fn bounce(s: &mut Sphere, size: f64) -> (f64, u64) {
         } else {
             continue;
         }
-        s.vel[k] = -v;
-        imp += 2.0 * s.mass * v.abs();
+        imp += reflect_axis(s, k);
         hits += 1;
     }
     (imp, hits)

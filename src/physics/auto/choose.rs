@@ -283,8 +283,8 @@ pub fn choose(s: &Summary, ask: Ask) -> Choice {
     let per_step = (r.contacts + r.walls + r.crossings) * dt;
     let exact_cap = (EVENT_CAP_BASE + EVENT_CAP_PER_SPHERE * s.count as u64) as f64;
     // `swept`'s caps, of a cluster and of a step, taken for a part's contacts.
-    let swept_cap = (swept::EVENT_CAP_BASE + swept::EVENT_CAP_PER_SPHERE * s.count) as f64;
-    let swept_budget = (swept::BUDGET_BASE + swept::BUDGET_PER_SPHERE * s.count as u64) as f64;
+    let swept_cap = swept::event_cap(s.count) as f64;
+    let swept_budget = swept::budget(s.count) as f64;
     let tol_text = format!("tol {tol}");
     let swept_fits = r.contacts.max(0.0) * dt / f64::from(swept_parts.max(1)) < swept_cap
         && swept_work(s, dt, swept_parts) < swept_budget;

@@ -197,7 +197,7 @@ impl Run {
                 self.heap.push(pair_event(t, i, j, a, b, 0, 0));
             }
         }
-        let cap = super::EVENT_CAP_BASE + super::EVENT_CAP_PER_SPHERE * self.ids.len();
+        let cap = super::event_cap(self.ids.len());
         let work_cap = sh.work_per_member.saturating_mul(self.ids.len() as u64);
         self.work = pairs.len() as u64;
         let mut done = 0usize;

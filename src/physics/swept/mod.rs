@@ -64,6 +64,22 @@ pub const BUDGET_PER_SPHERE: u64 = 100_000;
 pub const EVENT_CAP_BASE: usize = 10_000;
 pub const EVENT_CAP_PER_SPHERE: usize = 64;
 
+/// The events a cluster of `members` spheres may take (its event cap).
+#[must_use]
+pub fn event_cap(members: usize) -> usize {
+    EVENT_CAP_BASE.saturating_add(EVENT_CAP_PER_SPHERE.saturating_mul(members))
+}
+
+/// The work budget of a step of `n` spheres, in pair checks.
+#[must_use]
+pub fn budget(n: usize) -> u64 {
+    budget_from(BUDGET_BASE, BUDGET_PER_SPHERE, n)
+}
+
+fn budget_from(base: u64, per: u64, n: usize) -> u64 {
+    base.saturating_add(per.saturating_mul(n as u64))
+}
+
 #[derive(Default)]
 pub struct Swept {
     detect: Detection,
@@ -206,10 +222,10 @@ impl Swept {
     #[cfg_attr(not(feature = "experiments"), expect(clippy::unused_self))]
     fn budget_of(&self, n: usize) -> u64 {
         #[cfg(feature = "experiments")]
-        let (base, per) = (self.knobs.budget).unwrap_or((BUDGET_BASE, BUDGET_PER_SPHERE));
-        #[cfg(not(feature = "experiments"))]
-        let (base, per) = (BUDGET_BASE, BUDGET_PER_SPHERE);
-        base.saturating_add(per.saturating_mul(n as u64))
+        if let Some((base, per)) = self.knobs.budget {
+            return budget_from(base, per, n);
+        }
+        budget(n)
     }
 
     /// One part of a step (see `parts.rs`), with `left` work of the step's
