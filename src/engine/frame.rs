@@ -2,9 +2,10 @@
 //! world, the model, the executor, and the back snapshot to fill.
 use super::Settings;
 use super::probe::Probe;
-use super::snapshot::{Overlap, OverlapScratch, Snapshot};
+use super::snapshot::{OverlapScratch, Snapshot};
 use crate::physics::auto::Choice;
 use crate::physics::exec::Busy;
+use crate::physics::overlap::Overlap;
 use crate::physics::{Exec, Model, ModelKind, World};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};

@@ -5,7 +5,7 @@ use crate::physics::auto::Choice;
 use crate::physics::broad::Grid;
 use crate::physics::discrete::pair_budget;
 use crate::physics::exec::{Busy, for_each_block_of, for_each_chunk, work_ns};
-use crate::physics::sphere::overlap_rel;
+use crate::physics::overlap::{self, Overlap};
 use crate::physics::world::escapes;
 use crate::physics::{Counters, Exec, ModelKind, World};
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
@@ -227,25 +227,6 @@ impl Snapshot {
     }
 }
 
-/// The overlap readout of a frame.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct Overlap {
-    /// Deepest pair overlap over the smaller radius.
-    pub deepest_rel: f64,
-    /// Only some overlapping pairs were looked at: `deepest_rel` is a lower bound.
-    pub partial: bool,
-}
-
-impl Overlap {
-    /// A readout that looked at every pair.
-    pub fn complete(deepest_rel: f64) -> Overlap {
-        Overlap {
-            deepest_rel,
-            partial: false,
-        }
-    }
-}
-
 /// A grid kept between frames for the overlap check, searched on the
 /// frame's executor (`World::max_overlap_rel` would rebuild it serially).
 #[derive(Default)]
@@ -261,8 +242,7 @@ impl OverlapScratch {
     }
 
     /// Same value as `World::max_overlap_rel` while at most `limit` pairs
-    /// overlap (the max is order-free). The pairs are looked at, never
-    /// kept; past `limit` the readout stops, so a heap of overlapping
+    /// overlap; past `limit` the readout stops, so a heap of overlapping
     /// spheres (a file scene) costs a frame no more than a step may.
     pub(crate) fn measure_within(
         &mut self,
@@ -270,74 +250,6 @@ impl OverlapScratch {
         exec: &dyn Exec,
         limit: usize,
     ) -> Overlap {
-        let sp = &world.spheres;
-        self.grid.build(sp, world.size, |s| (s.pos, s.radius), exec);
-        // Depths are never negative, and such f64s order as their bits.
-        let worst = AtomicU64::new(0);
-        let deepest = |i: u32, j: u32| {
-            let (a, b) = (&sp[i as usize], &sp[j as usize]);
-            let s = a.radius + b.radius;
-            if a.pos.distance_squared(b.pos) < s * s {
-                let rel = overlap_rel(a.pos, a.radius, b.pos, b.radius);
-                worst.fetch_max(rel.to_bits(), Ordering::Relaxed);
-                return true;
-            }
-            false
-        };
-        let all = self.grid.count_within(exec, &deepest, limit);
-        Overlap {
-            deepest_rel: f64::from_bits(worst.into_inner()),
-            partial: !all,
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::physics::{Serial, Sphere};
-    use glam::DVec3;
-
-    /// `n` spheres of radius 0.01 within 1e-3 of the centre: every pair
-    /// overlaps, by different depths.
-    fn heap(n: u32) -> World {
-        let spheres = (0..n)
-            .map(|i| {
-                let d = |k: u32| f64::from((i.wrapping_mul(2_654_435_761) >> k) % 1000) * 1e-6;
-                Sphere {
-                    pos: DVec3::new(0.5 + d(0), 0.5 + d(10), 0.5 + d(20)),
-                    vel: DVec3::ZERO,
-                    radius: 0.01,
-                    mass: 1.0,
-                }
-            })
-            .collect();
-        World::new(1.0, spheres)
-    }
-
-    #[test]
-    fn the_readout_within_its_budget_is_the_brute_force_value() {
-        let world = heap(60); // 1 770 overlapping pairs
-        let full = world.max_overlap_rel();
-        assert!(full > 0.5, "{full}");
-        let mut s = OverlapScratch::default();
-        for limit in [1_770, 1_771, usize::MAX / 2] {
-            let o = s.measure_within(&world, &Serial, limit);
-            assert_eq!(o, Overlap::complete(full), "limit {limit}");
-        }
-    }
-
-    #[test]
-    fn past_its_budget_the_readout_stops_and_says_it_gives_a_lower_bound() {
-        let world = heap(60);
-        let full = world.max_overlap_rel();
-        let o = OverlapScratch::default().measure_within(&world, &Serial, 1_769);
-        assert!(o.partial);
-        assert!(
-            o.deepest_rel > 0.0 && o.deepest_rel <= full,
-            "{o:?} vs {full}"
-        );
-        let o = OverlapScratch::default().measure_within(&world, &Serial, 10);
-        assert!(o.partial && o.deepest_rel <= full, "{o:?}");
+        overlap::deepest(&mut self.grid, world, exec, Some(limit))
     }
 }

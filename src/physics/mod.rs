@@ -14,6 +14,7 @@ pub(crate) mod free_space;
 pub(crate) mod huge_pages;
 mod kind;
 mod model;
+pub mod overlap;
 pub(crate) mod prefetch;
 pub mod reference;
 pub mod relax;

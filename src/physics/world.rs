@@ -1,4 +1,4 @@
-use super::sphere::{Sphere, overlap_rel};
+use super::sphere::Sphere;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Hands out generations: a number is never given twice in a process, so a
@@ -133,14 +133,11 @@ impl World {
             .count()
     }
 
-    /// Deepest pair overlap divided by the smaller radius (0 if none).
+    /// Deepest pair overlap divided by the smaller radius (0 if none):
+    /// [`overlap::deepest`](super::overlap::deepest) on one thread.
     pub fn max_overlap_rel(&self) -> f64 {
-        let mut worst: f64 = 0.0;
-        super::broad::for_each_near_pair(&self.spheres, self.size, |i, j| {
-            let (a, b) = (&self.spheres[i], &self.spheres[j]);
-            worst = worst.max(overlap_rel(a.pos, a.radius, b.pos, b.radius));
-        });
-        worst
+        let mut grid = super::broad::Grid::default();
+        super::overlap::deepest(&mut grid, self, &super::exec::Serial, None).deepest_rel
     }
 
     pub fn has_non_finite(&self) -> bool {
