@@ -11,9 +11,11 @@
 //! bytes and pacing), `view/` (what is drawn, into a buffer), and here the
 //! loop itself: `run` (engine, state, deadlines), `present` (a view of the
 //! state to one chunk on the wire), `state` (what the keys asked) and `msg`
-//! (what wakes the loop). The modules the tests and benches use are
+//! (what wakes the loop), with `look` (the style, camera and light the
+//! state owns and the view draws by). The modules the tests and benches use are
 //! re-exported here, one path each.
 mod input;
+pub mod look;
 mod msg;
 mod present;
 mod run;

@@ -1,8 +1,7 @@
 //! What the user has asked for, and what each key does to it. Commands for
 //! the engine come out of `apply`; nothing here touches a terminal.
 use super::input::keys::Action;
-use super::view::canvas::{DrawStyle, LIGHT_STEPS};
-use super::view::projection::Camera;
+use super::look::{Camera, DrawStyle, LIGHT_STEPS};
 use crate::engine::{Command, MAX_THREADS, Settings, Snapshot, Threading};
 use crate::physics::ModelKind;
 use crate::physics::auto::Tolerance;

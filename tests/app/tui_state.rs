@@ -3,8 +3,8 @@
 use crate::common::screen::settings;
 use ballpit::engine::{Command, Settings, Snapshot, Threading};
 use ballpit::physics::ModelKind;
-use ballpit::tui::canvas::{DrawStyle, LIGHT_STEPS};
 use ballpit::tui::keys::{Action, Press, lookup};
+use ballpit::tui::look::{DrawStyle, LIGHT_STEPS};
 use ballpit::tui::state::{AppState, CAMERA_STEP, MAX_PITCH, MAX_TICK, MIN_RADIUS, RADIUS_STEP};
 use std::sync::LazyLock;
 

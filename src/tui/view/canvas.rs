@@ -1,61 +1,29 @@
 //! The picture: spheres as filled discs (points when smaller than a pixel)
 //! over a depth buffer that keeps the nearest at each pixel, and the cube's
 //! wireframe tested against that depth so edges hide behind near spheres.
-use super::projection::{Camera, Projection};
+use super::projection::Projection;
 use super::theme::{Palette, Ramp};
 use crate::engine::SphereView;
+use crate::tui::look::{Camera, DrawStyle, LIGHT_STEPS};
 use ratatui::buffer::{Buffer, Cell};
 use ratatui::layout::Rect;
 use ratatui::style::Color;
-use strum::IntoStaticStr;
 
-/// `v` cycles these.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, IntoStaticStr)]
-pub enum DrawStyle {
-    /// Braille dots (2×4 per cell), one colour per cell, coloured by speed.
-    #[strum(serialize = "braille, speed")]
-    PointsSpeed,
-    /// Braille dots coloured by depth (near bright, far dark).
-    #[strum(serialize = "braille, depth")]
-    PointsDepth,
-    /// Half-blocks (1×2 per cell), each pixel lit by the light.
-    #[strum(serialize = "shaded blocks")]
-    Shaded,
-}
-
-impl DrawStyle {
-    /// The `v` key's cycle, in the order of declaration (a match, as every
-    /// cycle of keys is written: the compiler sees a style left out).
-    #[must_use]
-    pub fn next(self) -> DrawStyle {
-        match self {
-            DrawStyle::PointsSpeed => DrawStyle::PointsDepth,
-            DrawStyle::PointsDepth => DrawStyle::Shaded,
-            DrawStyle::Shaded => DrawStyle::PointsSpeed,
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        self.into()
-    }
-
-    fn sub(self) -> (usize, usize) {
-        match self {
-            DrawStyle::Shaded => (1, 2),
-            _ => (2, 4),
-        }
-    }
-
-    fn ramp(self) -> Ramp {
-        match self {
-            DrawStyle::PointsDepth => Ramp::Depth,
-            _ => Ramp::Speed,
-        }
+/// Pixels per cell the style draws with.
+fn sub_of(style: DrawStyle) -> (usize, usize) {
+    match style {
+        DrawStyle::Shaded => (1, 2),
+        _ => (2, 4),
     }
 }
 
-/// Light positions `l` steps through: azimuths around the view axis.
-pub const LIGHT_STEPS: u8 = 8;
+/// The colour ramp the style colours points with.
+fn ramp_of(style: DrawStyle) -> Ramp {
+    match style {
+        DrawStyle::PointsDepth => Ramp::Depth,
+        _ => Ramp::Speed,
+    }
+}
 
 /// Everything the canvas depends on besides the spheres.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -97,7 +65,7 @@ impl Raster {
         if area.width == 0 || area.height == 0 {
             return;
         }
-        let (sx, sy) = scene.style.sub();
+        let (sx, sy) = sub_of(scene.style);
         let proj = Projection::new(
             area.width,
             area.height,
@@ -147,7 +115,7 @@ impl Raster {
             let Some(p) = proj.project(s.pos.map(f64::from)) else {
                 continue;
             };
-            let t = match scene.style.ramp() {
+            let t = match ramp_of(scene.style) {
                 Ramp::Speed if hot > 0.0 => f64::from(s.speed) / hot,
                 Ramp::Speed => 0.0,
                 Ramp::Depth => 1.0 - (p.depth - near) / (far - near),
@@ -278,7 +246,7 @@ impl Raster {
         match self.shade[k] {
             EDGE => scene.palette.edge(),
             s => scene.palette.ramp(
-                scene.style.ramp(),
+                ramp_of(scene.style),
                 f32::from(self.level[k]) / f32::from(RAMP_LEVELS - 1),
                 f32::from(s) / f32::from(SHADES),
             ),

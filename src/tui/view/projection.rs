@@ -1,24 +1,7 @@
 //! Perspective camera: world points to sub-cell pixels. Lengths on screen are
 //! measured in cell widths, so a pixel's width and height come from the cell
 //! aspect and circles stay circles whatever the font.
-
-/// The camera orbits the cube's centre; arrows change yaw and pitch.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Camera {
-    /// Radians around the vertical axis.
-    pub yaw: f64,
-    /// Radians above the horizon.
-    pub pitch: f64,
-}
-
-impl Default for Camera {
-    fn default() -> Self {
-        Camera {
-            yaw: 0.5,
-            pitch: 0.35,
-        }
-    }
-}
+use crate::tui::look::Camera;
 
 /// Eye distance from the cube centre, in box lengths: near enough for a clear
 /// perspective, far enough that the near corner doesn't balloon.
