@@ -52,11 +52,10 @@ fn label(flag: &str, given_as_flag: bool, file_with_key: Option<&str>) -> String
 
 /// The bytes of a scene file as text, or a message saying where they are
 /// not UTF-8.
-#[allow(clippy::naive_bytecount)] // once per bad file: no crate for it
 pub(crate) fn utf8(bytes: Vec<u8>, name: &str) -> Result<String, BadInput> {
     String::from_utf8(bytes).or_else(|e| {
         let at = e.utf8_error().valid_up_to();
-        let line = e.as_bytes()[..at].iter().filter(|&&b| b == b'\n').count() + 1;
+        let line = memchr::memchr_iter(b'\n', &e.as_bytes()[..at]).count() + 1;
         bad!("{name} line {line}: not UTF-8 text")
     })
 }
@@ -69,13 +68,8 @@ fn looks_like_csv(text: &str) -> bool {
 }
 
 /// The 1-based line holding byte `at` of `text`.
-#[allow(clippy::naive_bytecount)] // once per message: no crate for it
 pub(crate) fn line_of(text: &str, at: usize) -> usize {
-    text.as_bytes()[..at.min(text.len())]
-        .iter()
-        .filter(|&&b| b == b'\n')
-        .count()
-        + 1
+    memchr::memchr_iter(b'\n', &text.as_bytes()[..at.min(text.len())]).count() + 1
 }
 
 /// `name` ends in `.ext`, in any case (`END.CSV` is a CSV, as the screen's
