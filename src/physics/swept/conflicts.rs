@@ -12,7 +12,7 @@ use crate::physics::exec::{Exec, for_each_chunk, or_serial, work_ns};
 use crate::physics::sphere::Sphere;
 use crate::physics::wide::wide;
 use glam::DVec3;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicU8, AtomicU32, AtomicU64, AtomicUsize, Ordering};
 
 /// Predicted nanoseconds of making a grown ball and comparing it with its
 /// neighbours (docs/threading.md).
@@ -20,68 +20,88 @@ const NS_PER_BALL: usize = 50;
 /// Slots per block when making their balls in parallel.
 const BALL_BLOCK: usize = 2048;
 
-/// By slot, what the cluster's last finished run left.
+/// By slot, what the cluster's last finished run left. Kept in atomics so
+/// a block of runs writes its own members' slots on its lane (each slot is
+/// one cluster's, and one cluster runs once a round); the bystanders that
+/// joined are written where the runs are collected.
 #[derive(Default)]
 pub(super) struct Finished {
-    /// Where the member's record is, [`RecordAt::NONE`] until its cluster ran.
-    at: Vec<RecordAt>,
-    /// Whether (and why) that run was capped.
-    pub capped: Vec<Option<Coarse>>,
+    /// Where the member's record is (chunk in the high half, index in the
+    /// low), [`NO_RECORD`] until its cluster ran.
+    at: Vec<AtomicU64>,
     /// The round that run was made in ([`NOT_RUN`] before any).
-    pub ran: Vec<u32>,
-    /// Whether the member's ball grew past the one the grid holds for it.
-    grew: Vec<bool>,
+    ran: Vec<AtomicU32>,
+    /// Whether (and why) that run was capped, and whether the member's ball
+    /// grew past the one the grid holds for it ([`Marks`]).
+    marks: Vec<AtomicU8>,
     /// The runs' outputs, each taken whole from the block that wrote it
     /// (not copied: a record and its turns are kept once). Not pooled for
     /// reuse: chunks of any size would each keep the largest they ever held.
     chunks: Vec<Chunk>,
 }
 
-/// Where a member's record is: its chunk, and its index in it.
-#[derive(Clone, Copy)]
-struct RecordAt {
-    chunk: u32,
-    member: u32,
-}
-
-impl RecordAt {
-    /// No record: no chunk has this number.
-    const NONE: RecordAt = RecordAt {
-        chunk: u32::MAX,
-        member: u32::MAX,
-    };
-}
+/// No record: no chunk has this number.
+const NO_RECORD: u64 = u64::MAX;
 
 /// `Finished::ran` of a slot whose cluster has not run.
 const NOT_RUN: u32 = u32::MAX;
 
+/// A slot's cap and growth, packed in a byte.
+struct Marks;
+
+impl Marks {
+    const GREW: u8 = 1 << 2;
+
+    fn pack(capped: Option<Coarse>, grew: bool) -> u8 {
+        let c = match capped {
+            None => 0,
+            Some(Coarse::Events) => 1,
+            Some(Coarse::Work) => 2,
+        };
+        c | if grew { Marks::GREW } else { 0 }
+    }
+
+    fn capped(m: u8) -> Option<Coarse> {
+        match m & 3 {
+            0 => None,
+            1 => Some(Coarse::Events),
+            _ => Some(Coarse::Work),
+        }
+    }
+}
+
 impl Finished {
     pub fn reset(&mut self, m: usize) {
         self.at.clear();
-        self.at.resize(m, RecordAt::NONE);
-        self.capped.clear();
-        self.capped.resize(m, None);
+        self.at.resize_with(m, || AtomicU64::new(NO_RECORD));
         self.ran.clear();
-        self.ran.resize(m, NOT_RUN);
-        self.grew.clear();
-        self.grew.resize(m, false);
+        self.ran.resize_with(m, || AtomicU32::new(NOT_RUN));
+        self.marks.clear();
+        self.marks.resize_with(m, || AtomicU8::new(0));
         self.chunks.clear();
     }
 
     /// Drops every record: all the slots are about to run again as one
     /// cluster, so none is read again, and its memory is free for theirs.
     pub fn forget(&mut self) {
-        self.at.fill(RecordAt::NONE);
-        self.grew.fill(false);
+        self.at.iter_mut().for_each(|a| *a.get_mut() = NO_RECORD);
+        // The caps stay (the one run sets them all again); growth goes.
+        for m in &mut self.marks {
+            *m.get_mut() &= !Marks::GREW;
+        }
         self.chunks.clear();
     }
 
     /// Room for a slot added after the first round.
     pub fn push(&mut self) {
-        self.at.push(RecordAt::NONE);
-        self.capped.push(None);
-        self.ran.push(NOT_RUN);
-        self.grew.push(false);
+        self.at.push(AtomicU64::new(NO_RECORD));
+        self.ran.push(AtomicU32::new(NOT_RUN));
+        self.marks.push(AtomicU8::new(0));
+    }
+
+    /// The number the next chunk kept will have.
+    pub fn next_chunk(&self) -> u32 {
+        self.chunks.len() as u32
     }
 
     /// Takes a block's chunk in (its runs shrank it to its size); returns
@@ -91,19 +111,30 @@ impl Finished {
         (self.chunks.len() - 1) as u32
     }
 
-    /// Slot `s` finished as member `k` of chunk `c`.
-    pub fn set(&mut self, s: usize, c: u32, k: usize) {
-        self.at[s] = RecordAt {
-            chunk: c,
-            member: k as u32,
-        };
-        self.grew[s] = self.record_in(c, k).is_some_and(|(m, _)| m.grew);
+    /// Slot `s` finished in round `round` as member `k` (record `m`) of
+    /// chunk `c`, its run capped as `capped`. A chunk not yet kept is named
+    /// by the number it will have.
+    pub fn set(&self, s: usize, c: u32, k: usize, m: &Member, capped: Option<Coarse>, round: u32) {
+        let at = (u64::from(c) << 32) | k as u64;
+        self.at[s].store(at, Ordering::Relaxed);
+        self.ran[s].store(round, Ordering::Relaxed);
+        self.marks[s].store(Marks::pack(capped, m.grew), Ordering::Relaxed);
+    }
+
+    /// The round slot `s`'s cluster last ran in ([`NOT_RUN`] before any).
+    pub fn ran(&self, s: usize) -> u32 {
+        self.ran[s].load(Ordering::Relaxed)
+    }
+
+    /// Whether (and why) slot `s`'s last run was capped.
+    pub fn capped(&self, s: usize) -> Option<Coarse> {
+        Marks::capped(self.marks[s].load(Ordering::Relaxed))
     }
 
     /// Slot `s`'s record and its turns, if its cluster ran.
     pub fn record(&self, s: usize) -> Option<(&Member, &[Turn])> {
-        let RecordAt { chunk, member } = self.at[s];
-        self.record_in(chunk, member as usize)
+        let at = self.at[s].load(Ordering::Relaxed);
+        self.record_in((at >> 32) as u32, (at & u64::from(u32::MAX)) as usize)
     }
 
     /// Member `k` of chunk `c` and its turns.
@@ -115,7 +146,7 @@ impl Finished {
 
     /// Whether slot `s`'s ball grew past the one the grid holds for it.
     pub fn grew(&self, s: usize) -> bool {
-        self.grew[s]
+        self.marks[s].load(Ordering::Relaxed) & Marks::GREW != 0
     }
 
     /// Whether the spheres of slots `a` and `b` come within touching
@@ -123,7 +154,7 @@ impl Finished {
     /// or one not run) meets everyone: a merge costs time, never a result.
     fn meet(&self, a: usize, b: usize, spheres: &[Sphere], dt: f64) -> bool {
         let path = |s: usize| {
-            let (m, turns) = self.record(s).filter(|_| self.capped[s].is_none())?;
+            let (m, turns) = self.record(s).filter(|_| self.capped(s).is_none())?;
             Some((&spheres[m.id as usize], turns))
         };
         let (Some((sa, ta)), Some((sb, tb))) = (path(a), path(b)) else {

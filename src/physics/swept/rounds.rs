@@ -49,13 +49,29 @@ const PERCOLATION: (usize, usize) = (3, 10);
 /// What one block of clusters left.
 #[derive(Default)]
 struct BlockOut {
-    /// Finished clusters: (why capped, how many of the chunk's members are
-    /// theirs, the work the run did).
-    done: Vec<(Option<Coarse>, u32, u64)>,
+    /// Finished clusters, in order.
+    done: Vec<RunDone>,
+    /// Where in the chunk the bystanders that joined the runs are, run
+    /// after run (the runs' own members are in `Finished` already).
+    joined: Vec<u32>,
     /// Their members and turns, taken whole into `Finished` when collected.
     chunk: Chunk,
     /// Finished runs' (member, member of another cluster) to compare.
     cross: Vec<(u32, u32)>,
+}
+
+/// One finished run of a block.
+struct RunDone {
+    /// Why it was capped, if it was.
+    capped: Option<Coarse>,
+    /// How many of the chunk's members are its.
+    len: u32,
+    /// The work it did.
+    work: u64,
+    /// Where its bystanders end in the block's `joined`.
+    joined_end: u32,
+    /// A slot of its own cluster (none if it had only bystanders).
+    own: Slot,
 }
 
 /// The state kept from one round to the next of a step part, and scratch
@@ -106,7 +122,7 @@ impl Rounds {
         let Some((m, _)) = self.fin.record(s) else {
             unreachable!("every involved sphere finished");
         };
-        (m, self.fin.capped[s])
+        (m, self.fin.capped(s))
     }
 
     /// Runs the events of a step: `meets` are the pairs whose straight paths
@@ -273,10 +289,14 @@ impl Rounds {
         let (runs, outs, todo) = (&self.runs, &self.outs, &self.batch.todo);
         let (order, pairs) = (&self.batch.order, &self.batch.pairs);
         let lanes = lanes_of(exec, blocks, work_ns(order.len(), NS_PER_MEMBER));
+        // Chunks are kept in block order: block `b`'s will be `first + b`.
+        let (fin, first, round) = (&self.fin, self.fin.next_chunk(), self.stats.rounds as u32);
         exec.for_blocks(lanes, blocks, &|lane, b| {
             let mut run = runs[lane].lock();
             let mut out = outs[b].lock();
+            let out = &mut *out;
             out.done.clear();
+            out.joined.clear();
             out.chunk.clear();
             out.cross.clear();
             let end = ((b + 1) * CLUSTER_BLOCK).min(todo.len());
@@ -295,8 +315,14 @@ impl Rounds {
                 let before = out.chunk.members.len();
                 run.emit(&mut out.chunk);
                 out.cross.extend_from_slice(&run.cross);
-                let len = (out.chunk.members.len() - before) as u32;
-                out.done.push((run.capped, len, run.work));
+                let own = set_own(fin, sh, out, before, first + b as u32, (run.capped, round));
+                out.done.push(RunDone {
+                    capped: run.capped,
+                    len: (out.chunk.members.len() - before) as u32,
+                    work: run.work,
+                    joined_end: out.joined.len() as u32,
+                    own,
+                });
             }
             // Kept at its size (room was reserved by estimate): the copy is
             // made here, on the block's lane, not where the chunks are taken.
@@ -319,73 +345,63 @@ impl Rounds {
             let out = block.get_mut();
             let chunk = std::mem::take(&mut out.chunk);
             let c = self.fin.keep(chunk);
-            let mut k = 0usize;
-            for &(capped, len, work) in &out.done {
-                self.work += work;
-                let (k0, k1) = (k, k + len as usize);
-                k = k1;
-                self.take_run(c, k0..k1, capped, known);
+            let (mut k, mut j) = (0usize, 0usize);
+            for r in &out.done {
+                self.work += r.work;
+                let joined = &out.joined[j..r.joined_end as usize];
+                self.take_run(c, k, joined, r, known);
+                (k, j) = (k + r.len as usize, r.joined_end as usize);
             }
             cross.extend_from_slice(&out.cross);
         }
         self.outs = outs;
         // What a rerun cluster noted before is replaced by what it noted now.
-        let (slot, ran) = (&self.part.slot, &self.fin.ran);
+        let (slot, fin) = (&self.part.slot, &self.fin);
         let mut k = 0;
         cross.retain(|&(a, _)| {
             k += 1;
-            k > fresh || ran[slot[a as usize].index()] != round
+            k > fresh || fin.ran(slot[a as usize].index()) != round
         });
         self.conf.cross = cross;
     }
 
-    /// One finished run of this round, its members `at` in chunk `c` (of
-    /// `Finished`): each gets its slot (a bystander that joined the run, a
-    /// new one) and its record, and they all join one cluster; when the run
-    /// took a bystander another run of this round took too (slots from
-    /// `known` on are this round's), the two must run again as one.
-    fn take_run(
-        &mut self,
-        c: u32,
-        at: std::ops::Range<usize>,
-        capped: Option<Coarse>,
-        known: usize,
-    ) {
+    /// One finished run `r` of this round, its members from `k0` on in
+    /// chunk `c` (of `Finished`), its own members' records set already (a
+    /// slot from before this round is of the run's own cluster: the run
+    /// only notes others'). Each bystander that joined it (at `joined`)
+    /// gets its slot and record, and joins the run's cluster; when one
+    /// joined another run of this round too (slots from `known` on are
+    /// this round's), the two must run again as one.
+    fn take_run(&mut self, c: u32, k0: usize, joined: &[u32], r: &RunDone, known: usize) {
         let round = self.stats.rounds as u32;
-        let mut root = Slot::NONE;
+        let mut root = if r.own.is_none() {
+            Slot::NONE
+        } else {
+            self.part.find(r.own)
+        };
         let mut twice = false;
-        let mut first = None;
-        // Whether `root` is the run's own cluster's.
-        let mut own_root = false;
-        for at in at {
-            let Some((m, _)) = self.fin.record_in(c, at) else {
+        let first = self.fin.record_in(c, k0).map(|(m, _)| m.id);
+        for &k in joined {
+            let Some((m, _)) = self.fin.record_in(c, k as usize) else {
                 unreachable!("a chunk holds the members its runs wrote");
             };
             let id = m.id;
-            first.get_or_insert(id);
-            // A bystander that joined this run may have got a slot from an
-            // earlier run of this round (or none yet).
+            // It may have got a slot from an earlier run of this round.
             let s = match self.part.slot[id as usize] {
                 Slot::NONE => self.add_slot(id),
                 s => s,
             };
-            let joined = s.index() >= known;
-            twice |= joined && self.fin.ran[s.index()] == round;
-            self.fin.set(s.index(), c, at);
-            self.fin.capped[s.index()] = capped;
-            self.fin.ran[s.index()] = round;
-            // A slot from before this round is of the run's own cluster
-            // (the run only notes those of others): it has the root already.
+            debug_assert!(s.index() >= known, "a bystander's slot is this round's");
+            twice |= self.fin.ran(s.index()) == round;
+            let Some((m, _)) = self.fin.record_in(c, k as usize) else {
+                unreachable!("a chunk holds the members its runs wrote");
+            };
+            self.fin.set(s.index(), c, k as usize, m, r.capped, round);
             root = if root.is_none() {
                 self.part.find(s)
-            } else if joined {
-                self.part.link(root, s)
-            } else if own_root {
-                root
             } else {
                 self.part.link(root, s)
             };
-            own_root |= !joined;
         }
         match (twice, first) {
             (true, Some(first)) => {
@@ -407,4 +423,31 @@ impl Rounds {
         }
         self.conf.found = conflicts;
     }
+}
+
+/// The members a run just wrote (`out.chunk.members[from..]`, in the chunk
+/// that will be number `c`): those with a slot at the run's start are of
+/// its own cluster, whose slots no other run of the round writes, so their
+/// records are set here, on the run's lane; the places of the rest,
+/// bystanders that joined it, go to `out.joined`. `(capped, round)` are
+/// the run's. Returns a slot of its own (none if it had only bystanders).
+fn set_own(
+    fin: &Finished,
+    sh: &Shared,
+    out: &mut BlockOut,
+    from: usize,
+    c: u32,
+    (capped, round): (Option<Coarse>, u32),
+) -> Slot {
+    let mut own = Slot::NONE;
+    for (k, m) in out.chunk.members.iter().enumerate().skip(from) {
+        let s = sh.slot[m.id as usize];
+        if s.is_none() {
+            out.joined.push(k as u32);
+        } else {
+            own = s;
+            fin.set(s.index(), c, k, m, capped, round);
+        }
+    }
+    own
 }
