@@ -59,7 +59,7 @@ impl<L: Locality> EventLoop<L> {
 pub(super) fn prefetch_next_crossing(cells: &CellGrid, holds: &[Queued], next: Option<Label>) {
     if let Some(next) = next
         && let Some(&q) = holds.get(next.index())
-        && q.is_broad()
+        && q.is_locality()
         && q.event().kind() == Kind::Cross
     {
         cells.prefetch_cross(next, q.event().mask());
