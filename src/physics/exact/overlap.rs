@@ -26,58 +26,59 @@ const CELL_BLOCK: usize = 1 << 14;
 /// bodies were last written to (the max is order-free, so the same bits),
 /// from neighbour lists: each listed pair once.
 pub(super) fn in_lists(lists: &NeighbourLists, bodies: &Bodies, exec: &dyn Exec) -> f64 {
-    deepest(|keep| {
-        let n = bodies.len();
-        for_each_block(exec, n.div_ceil(BLOCK), &|b| {
-            let spheres = (b * BLOCK..((b + 1) * BLOCK).min(n)).map(Label::at);
-            keep(spheres.fold(0.0, |w: f64, i| {
+    let worst = Mutex::new(0.0f64);
+    let n = bodies.len();
+    for_each_block(exec, n.div_ceil(BLOCK), &|b| {
+        let spheres = (b * BLOCK..((b + 1) * BLOCK).min(n)).map(Label::at);
+        keep(
+            &worst,
+            spheres.fold(0.0, |w: f64, i| {
                 lists
                     .of(i)
                     .iter()
                     .filter(|l| l.j > i)
                     .fold(w, |w, l| deeper(w, bodies, i, l.j))
-            }));
-        });
-    })
+            }),
+        );
+    });
+    worst.into_inner()
 }
 
 /// As [`in_lists`], from the cell grid: the pairs in neighbouring cells,
 /// and the large spheres' scans.
 pub(super) fn in_cells(cells: &CellGrid, bodies: &Bodies, exec: &dyn Exec) -> f64 {
-    deepest(|keep| {
-        let n = cells.cells();
-        for_each_block(exec, n.div_ceil(CELL_BLOCK), &|b| {
-            let (mut own, mut near, mut w) = (Vec::new(), Vec::new(), 0.0);
-            let range = b * CELL_BLOCK..((b + 1) * CELL_BLOCK).min(n);
-            cells.for_each_near_pair(range, &mut own, &mut near, |i, j| {
-                w = deeper(w, bodies, i, j);
-            });
-            keep(w);
+    let worst = Mutex::new(0.0f64);
+    let n = cells.cells();
+    for_each_block(exec, n.div_ceil(CELL_BLOCK), &|b| {
+        let (mut own, mut near, mut w) = (Vec::new(), Vec::new(), 0.0);
+        let range = b * CELL_BLOCK..((b + 1) * CELL_BLOCK).min(n);
+        cells.for_each_near_pair(range, &mut own, &mut near, |i, j| {
+            w = deeper(w, bodies, i, j);
         });
-        // The few large ones: each small one they could touch, from
-        // their scan, and each other.
-        let mut out = Vec::new();
-        for &i in cells.bigs() {
-            let k = cells.candidates(i, bodies.radius(i), &mut out);
-            keep(
-                out[..k]
-                    .iter()
-                    .map(|&j| Label::from_raw(j))
-                    .filter(|&j| !cells.is_big(j) || j > i)
-                    .fold(0.0, |w, j| deeper(w, bodies, i, j)),
-            );
-        }
-    })
+        keep(&worst, w);
+    });
+    // The few large ones: each small one they could touch, from their
+    // scan, and each other.
+    let mut out = Vec::new();
+    for &i in cells.bigs() {
+        let k = cells.candidates(i, bodies.radius(i), &mut out);
+        keep(
+            &worst,
+            out[..k]
+                .iter()
+                .map(|&j| Label::from_raw(j))
+                .filter(|&j| !cells.is_big(j) || j > i)
+                .fold(0.0, |w, j| deeper(w, bodies, i, j)),
+        );
+    }
+    worst.into_inner()
 }
 
-/// The deepest of what `search` keeps, from any lane.
-fn deepest(search: impl FnOnce(&(dyn Fn(f64) + Sync))) -> f64 {
-    let worst = Mutex::new(0.0f64);
-    search(&|deepest: f64| {
-        let mut w = worst.lock();
-        *w = w.max(deepest);
-    });
-    worst.into_inner()
+/// `worst` raised to `deepest`, from any lane.
+#[inline]
+fn keep(worst: &Mutex<f64>, deepest: f64) {
+    let mut w = worst.lock();
+    *w = w.max(deepest);
 }
 
 /// `worst`, or the overlap of bodies `i` and `j` relative to the smaller
