@@ -4,36 +4,29 @@
 //! the next one's, instead of one after another (docs/perf-log.md,
 //! 2026-12-05).
 use super::cell_grid::CellGrid;
+use super::event_loop::EventLoop;
 use super::ids::Label;
+use super::locality::Locality;
 use super::queue::EventQueue;
 use super::schedule::{Event, Kind, Queued};
-use super::{Broad, Exact};
 
-impl Exact {
-    /// Start loading what the loop will read next: the cells a crossing
-    /// of `i` (event `ev`) reads and its pending partner's body; after a
-    /// contact or a wall, what predicting `i` reads first, and the
-    /// partner's records; and the records of the sphere whose event is
-    /// likely next (the queue's runner-up), so their cache misses wait
-    /// together while this event is processed. Returns the runner-up, for
-    /// a crossing to prefetch for it part-way through
+impl<L: Locality> EventLoop<L> {
+    /// Start loading what the loop will read next: what a crossing of `i`
+    /// (event `ev`) reads; after a contact or a wall, what predicting `i`
+    /// reads first, and the partner's records; and the records of the
+    /// sphere whose event is likely next (the queue's runner-up), so their
+    /// cache misses wait together while this event is processed. Returns
+    /// the runner-up, for a crossing to prefetch for it part-way through
     /// ([`prefetch_next_crossing`]).
     #[inline(always)]
     pub(super) fn prefetch_ahead(&self, i: Label, ev: Event) -> Option<Label> {
-        match (ev.kind(), &self.broad) {
-            (Kind::Cross, Broad::Cells(cells)) => {
-                cells.prefetch_cross(i, ev.mask());
-                // The crossing checks whether its pending contact still holds.
-                let (_, pending) = self.slots[i.index()].pending();
-                if pending.kind() == Kind::Pair {
-                    self.bodies.prefetch_one(pending.partner());
-                }
-            }
-            (Kind::Pair, _) => {
+        match ev.kind() {
+            Kind::Cross => self.locality.prefetch_cross(i, ev.mask(), &self.bodies),
+            Kind::Pair => {
                 self.prefetch_records(ev.partner().index());
-                self.prefetch_neighbours(i);
+                self.locality.prefetch_around(i, &self.bodies);
             }
-            (Kind::Wall, _) => self.prefetch_neighbours(i),
+            Kind::Wall => self.locality.prefetch_around(i, &self.bodies),
             _ => {}
         }
         let next = self.queue.runner_up();
@@ -43,43 +36,14 @@ impl Exact {
         next.map(Label::at)
     }
 
-    /// Start loading what predicting `i` reads first: the bodies in its
-    /// neighbour list, or the cells around it.
+    /// Start loading sphere `k`'s records, if `k` is a sphere: its body,
+    /// queue leaf, and what its locality keeps and reads first.
     #[inline(always)]
-    pub(super) fn prefetch_neighbours(&self, i: Label) {
-        match &self.broad {
-            Broad::Lists(nl) => {
-                for l in nl.of(i) {
-                    self.bodies.prefetch_one(l.j);
-                }
-            }
-            Broad::Cells(cells) => cells.prefetch_around(i),
-        }
-    }
-
-    /// Start loading sphere `k`'s records, if `k` is a sphere: its slot,
-    /// body and queue leaf, and what its broad phase reads first.
-    #[inline(always)]
-    pub(super) fn prefetch_records(&self, k: usize) {
-        use crate::physics::prefetch::{line, record};
+    fn prefetch_records(&self, k: usize) {
         if let Some(body) = self.bodies.get(k) {
-            line(body);
+            crate::physics::prefetch::line(body);
             self.queue.prefetch(k);
-            match &self.broad {
-                Broad::Cells(cells) => {
-                    if let (Some(slot), Some(holds)) = (self.slots.get(k), self.holds.get(k)) {
-                        record(slot);
-                        line(holds);
-                    }
-                    cells.prefetch_place(k);
-                }
-                Broad::Lists(nl) => {
-                    if let Some(ev) = self.events.get(k) {
-                        record(ev);
-                    }
-                    nl.prefetch(k);
-                }
-            }
+            self.locality.prefetch_records(k);
         }
     }
 }
@@ -95,7 +59,7 @@ impl Exact {
 pub(super) fn prefetch_next_crossing(cells: &CellGrid, holds: &[Queued], next: Option<Label>) {
     if let Some(next) = next
         && let Some(&q) = holds.get(next.index())
-        && q.is_broad()
+        && q.is_locality()
         && q.event().kind() == Kind::Cross
     {
         cells.prefetch_cross(next, q.event().mask());

@@ -1,4 +1,4 @@
-//! The second level both broad phases keep: the few spheres far larger than
+//! The second level both localities keep: the few spheres far larger than
 //! the bulk stay out of the grid (every small sphere checks them; a large
 //! one scans the cells over its own reach plus a skin and rescans when it
 //! leaves that skin), so radii 100x apart stay cheap.

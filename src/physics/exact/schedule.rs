@@ -1,5 +1,5 @@
 //! Predicting a sphere's next event: the earliest of a contact with one of its
-//! candidate partners, a wall contact, or a broad-phase event (leaving its
+//! candidate partners, a wall contact, or a locality event (leaving its
 //! neighbour-list skin, or crossing into another cell). Only that earliest
 //! event is kept (one per sphere, as Smallenburg's EDMD does); a contact
 //! stays valid while the partner's collision count is unchanged, and is
@@ -97,34 +97,34 @@ impl Event {
 }
 
 /// Which event the queue holds for a sphere in cell mode: its pending
-/// event ([`Queued::PENDING`]), or the broad-phase event that came first
+/// event ([`Queued::PENDING`]), or the locality event that came first
 /// (a crossing, with its direction, or a large sphere's rescan), which the
 /// grid tells cheaply, so only its kind and mask are kept. One byte: the
-/// mask in bits 0..3, bit 3 set for any broad-phase event, bit 4 for a rescan.
+/// mask in bits 0..3, bit 3 set for any locality event, bit 4 for a rescan.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Queued(u8);
 
 impl Queued {
     /// The queue holds the pending event itself.
     pub const PENDING: Queued = Queued(0);
-    const BROAD: u8 = 8;
+    const LOCALITY: u8 = 8;
     const RESCAN_BIT: u8 = 4;
     const RESCAN: u8 = 1 << Self::RESCAN_BIT;
     const MASK: u8 = 7;
 
     /// The queue holds `ev`, a crossing or a large sphere's rescan ([`Kind::Relist`]).
     #[inline(always)]
-    pub fn broad(ev: &Event) -> Queued {
-        Queued(Self::BROAD | ev.mask() | u8::from(ev.kind() == Kind::Relist) << Self::RESCAN_BIT)
+    pub fn locality(ev: &Event) -> Queued {
+        Queued(Self::LOCALITY | ev.mask() | u8::from(ev.kind() == Kind::Relist) << Self::RESCAN_BIT)
     }
 
-    /// Whether the queue holds a broad-phase event, not the pending one.
+    /// Whether the queue holds a locality event, not the pending one.
     #[inline(always)]
-    pub fn is_broad(self) -> bool {
+    pub fn is_locality(self) -> bool {
         self != Self::PENDING
     }
 
-    /// The broad-phase event held (meaningful when [`Self::is_broad`]).
+    /// The locality event held (meaningful when [`Self::is_locality`]).
     #[inline(always)]
     pub fn event(self) -> Event {
         Event::of(
@@ -160,7 +160,7 @@ impl Slot {
     pub fn queued(self, queued: Queued) -> Event {
         let ev = self.ev;
         // By index: which of the two it is is random (see `with_crossing`).
-        [ev, queued.event()][usize::from(queued.is_broad())]
+        [ev, queued.event()][usize::from(queued.is_locality())]
     }
 
     /// The pending event itself (not the crossing).
@@ -171,7 +171,7 @@ impl Slot {
 }
 
 /// The running earliest event of sphere `a` (already moved to `now = a.t`).
-/// Ties keep the first found: the broad-phase event, then walls, then
+/// Ties keep the first found: the locality event, then walls, then
 /// partners in the order offered.
 pub struct Predictor<'a> {
     a: Body,
@@ -186,7 +186,7 @@ pub struct Predictor<'a> {
 }
 
 impl<'a> Predictor<'a> {
-    /// Start from the broad-phase event `(in_t, ev)` (relative time) and the walls.
+    /// Start from the locality event `(in_t, ev)` (relative time) and the walls.
     #[inline]
     pub fn new(a: &Body, bodies: &'a Bodies, size: f64, in_t: f64, ev: Event) -> Self {
         let ra = bodies.radius_of(a);
@@ -321,13 +321,13 @@ mod tests {
         assert_eq!(Event::default().kind(), Kind::Idle);
     }
 
-    /// A broad-phase event reads back as it went in, and marks the slot.
+    /// A locality event reads back as it went in, and marks the slot.
     #[test]
-    fn a_queued_broad_event_reads_back() {
-        assert!(!Queued::PENDING.is_broad());
+    fn a_queued_locality_event_reads_back() {
+        assert!(!Queued::PENDING.is_locality());
         for (kind, mask) in [(Kind::Cross, 0), (Kind::Cross, 6), (Kind::Relist, 0)] {
-            let q = Queued::broad(&Event::of(kind, mask));
-            assert!(q.is_broad());
+            let q = Queued::locality(&Event::of(kind, mask));
+            assert!(q.is_locality());
             assert_eq!((q.event().kind(), q.event().mask()), (kind, mask));
         }
     }

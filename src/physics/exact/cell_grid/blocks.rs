@@ -1,4 +1,4 @@
-//! The spheres of each cell, for the cell-crossing broad phase, laid out for
+//! The spheres of each cell, for the cell-crossing locality, laid out for
 //! gathering a stencil of cells fast: each cell names a small block holding
 //! its count and its first [`BLOCK`] spheres, so collecting a cell is one
 //! fixed-size copy. Walking a linked list instead ends each cell with a

@@ -1,4 +1,4 @@
-//! Broad phase for dilute and moderate scenes: a cell grid with
+//! The locality for dilute and moderate scenes: a cell grid with
 //! cell-crossing events (Rapaport; `DynamO`). Cells are at least the largest
 //! bulk diameter, so spheres can only touch from neighbouring cells; a
 //! sphere's candidates are the spheres in the 27 cells around its own. A
@@ -195,7 +195,7 @@ impl CellGrid {
         (x as usize + 1) + q * ((y as usize + 1) + q * (z as usize + 1))
     }
 
-    /// The broad-phase event of sphere `i` (at `b.t`): its next cell crossing,
+    /// The locality event of sphere `i` (at `b.t`): its next cell crossing,
     /// or for a large sphere the edge of its skin. Relative time.
     #[inline]
     pub fn next_event(&self, i: Label, b: &Body) -> (f64, Event) {
@@ -288,7 +288,7 @@ impl CellGrid {
         self.scan_centre[k] = b.pos;
     }
 
-    /// Every sphere that sphere `i` could touch before its next broad-phase
+    /// Every sphere that sphere `i` could touch before its next locality
     /// event, into `out[..n]` (returns `n`; sphere `i` itself may be among
     /// them), as `Label::raw`s: the 27 cells around a small one, the cells
     /// over a large one's reach (its `radius` plus the bulk's and a skin)

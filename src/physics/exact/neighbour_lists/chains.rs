@@ -2,7 +2,7 @@
 //! intrusive singly linked chains, so a sphere moves between cells at a
 //! relist by unlinking it from its old cell's chain (a few spheres at most:
 //! cells are about a sphere and its skin wide) and pushing it on the new.
-//! Only rebuilds walk it; the cell-crossing broad phase, which gathers
+//! Only rebuilds walk it; the cell grid (the other locality), which gathers
 //! cells far more often, keeps its cells in
 //! [`CellBlocks`](crate::physics::exact::cell_grid::blocks::CellBlocks) instead.
 //! A sphere's cell is not stored: its owner recomputes it from the list

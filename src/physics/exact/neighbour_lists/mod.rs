@@ -1,4 +1,4 @@
-//! Broad phase of the event loop: neighbour lists with a skin, built from a
+//! A locality of the event loop: neighbour lists with a skin, built from a
 //! cell grid (Smallenburg's EDMD does the same; it measured faster than
 //! cell-crossing events because a sphere meets its neighbour list's edge far
 //! less often than a cell wall, and checks fewer partners per collision).
