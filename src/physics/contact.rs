@@ -27,41 +27,36 @@ pub fn pair_toi(dp: DVec3, dv: DVec3, sigma: f64) -> Option<f64> {
     Some(c / (-b + disc.sqrt()))
 }
 
-/// Time until the sphere touches a wall along each axis (infinite if it is
-/// not moving towards one). Overlapping a wall while moving into it gives 0.
+/// Earliest wall contact of a sphere at `pos` moving at `vel`: the time
+/// (infinite if it moves towards none; 0 if it overlaps a wall it moves
+/// into) and the mask of the axes hit then (bit `k` for axis `k`; a corner
+/// hit flips every axis that ties). The one wall time of impact of every
+/// model, with selects instead of branches on the signs of the velocity.
 #[inline]
-pub fn wall_toi_axes(s: &Sphere, size: f64) -> DVec3 {
-    let mut t = DVec3::splat(f64::INFINITY);
-    for k in 0..3 {
-        let v = s.vel[k];
-        let p = s.pos[k];
-        if v < 0.0 {
-            t[k] = ((p - s.radius) / -v).max(0.0);
-        } else if v > 0.0 {
-            t[k] = ((size - s.radius - p) / v).max(0.0);
-        }
+pub fn wall_toi(pos: DVec3, vel: DVec3, radius: f64, size: f64) -> (f64, u8) {
+    let mut t = [f64::INFINITY; 3];
+    for (k, tk) in t.iter_mut().enumerate() {
+        let v = vel[k];
+        // Indexing, not `if`: LLVM turns a select on the (random) sign back
+        // into a branch, and that branch mispredicted half the time.
+        let gap = [size - radius - pos[k], pos[k] - radius][(v < 0.0) as usize];
+        let dt = (gap / v.abs()).max(0.0);
+        *tk = [f64::INFINITY, dt][(v != 0.0) as usize];
     }
-    t
+    let tmin = t[0].min(t[1]).min(t[2]);
+    let mask = (t[0] == tmin) as u8 | ((t[1] == tmin) as u8) << 1 | ((t[2] == tmin) as u8) << 2;
+    (tmin, mask)
 }
 
-/// Earliest wall contact: time and the mask of axes hit at that time (a corner
-/// hit flips every axis that ties).
-#[inline]
-pub fn wall_toi(s: &Sphere, size: f64) -> (f64, [bool; 3]) {
-    let t = wall_toi_axes(s, size);
-    let tmin = t.min_element();
-    (tmin, [t.x == tmin, t.y == tmin, t.z == tmin])
-}
-
-/// Reflect `v' = v - 2 (v·n) n` on every axis in `mask` (axes from
+/// Reflect `v' = v - 2 (v·n) n` on every axis in `mask` (from
 /// [`wall_toi`], so the sphere moves into that wall). Returns the momentum
 /// given to the walls and the number of wall collisions.
 #[inline]
-pub fn reflect_walls(s: &mut Sphere, mask: [bool; 3]) -> (f64, u64) {
+pub fn reflect_walls(s: &mut Sphere, mask: u8) -> (f64, u64) {
     let mut impulse = 0.0;
     let mut hits = 0;
-    for (k, &hit) in mask.iter().enumerate() {
-        if hit && s.vel[k] != 0.0 {
+    for k in 0..3 {
+        if mask & (1 << k) != 0 && s.vel[k] != 0.0 {
             impulse += reflect_axis(s, k);
             hits += 1;
         }
@@ -96,4 +91,39 @@ pub fn resolve_pair(a: &mut Sphere, b: &mut Sphere) -> bool {
     a.vel -= (2.0 * b.mass / mt * u) * n;
     b.vel += (2.0 * a.mass / mt * u) * n;
     true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const R: f64 = 0.1;
+
+    #[test]
+    fn the_wall_time_is_the_gap_over_the_speed_towards_it() {
+        let pos = DVec3::new(0.3, 0.5, 0.5);
+        // Towards x = 0: the gap 0.3 - R at speed 2.
+        let (t, mask) = wall_toi(pos, DVec3::new(-2.0, 0.0, 0.0), R, 1.0);
+        assert_eq!((t, mask), ((0.3 - R) / 2.0, 0b001));
+        // Towards y = 1 and z = 0 at once from the centre: a corner, both axes.
+        let centre = DVec3::splat(0.5);
+        let (t, mask) = wall_toi(centre, DVec3::new(0.0, 1.0, -1.0), R, 1.0);
+        assert_eq!((t, mask), (0.5 - R, 0b110));
+        // At rest: no wall, ever.
+        let (t, _) = wall_toi(centre, DVec3::ZERO, R, 1.0);
+        assert_eq!(t, f64::INFINITY);
+        // Past a wall it moves into: now.
+        let (t, mask) = wall_toi(DVec3::new(0.95, 0.5, 0.5), DVec3::X, R, 1.0);
+        assert_eq!((t, mask), (0.0, 0b001));
+    }
+
+    #[test]
+    fn a_reflection_turns_the_axes_hit_and_keeps_the_energy() {
+        let mut s = Sphere::new(DVec3::splat(0.5), DVec3::new(1.0, -2.0, 3.0), R);
+        let e0 = s.kinetic_energy();
+        let (impulse, hits) = reflect_walls(&mut s, 0b011);
+        assert_eq!(s.vel, DVec3::new(-1.0, 2.0, 3.0));
+        assert_eq!((impulse, hits), (2.0 * s.mass * 3.0, 2));
+        assert!((s.kinetic_energy() - e0).abs() <= 1e-15 * e0);
+    }
 }

@@ -2,7 +2,6 @@
 //! tolerance, so every machine and every threading mode chooses alike. The
 //! costs are predicted from event and step counts, calibrated once against
 //! `ballpit tradeoff` (docs/models.md, "auto"), never timed.
-use crate::physics::exact::{EVENT_CAP_BASE, EVENT_CAP_PER_SPHERE};
 use crate::physics::kind::{Choice, ModelKind, Tolerance};
 use crate::physics::swept;
 use crate::physics::world::World;
@@ -281,7 +280,7 @@ pub fn choose(s: &Summary, ask: Ask) -> Choice {
     let c = costs(s, dt, swept_parts, frame, readouts);
     let r = rates(s);
     let per_step = (r.contacts + r.walls + r.crossings) * dt;
-    let exact_cap = (EVENT_CAP_BASE + EVENT_CAP_PER_SPHERE * s.count as u64) as f64;
+    let exact_cap = crate::physics::exact::event_cap(s.count) as f64;
     // `swept`'s caps, of a cluster and of a step, taken for a part's contacts.
     let swept_cap = swept::event_cap(s.count) as f64;
     let swept_budget = swept::budget(s.count) as f64;

@@ -8,14 +8,12 @@ use super::hooks::{self, Hooks};
 use super::ids::{Label, WorldId};
 use super::locality::Locality;
 use super::schedule::Kind;
-use super::{
-    EVENT_CAP_BASE, EVENT_CAP_PER_SPHERE, EightWay, EventQueue, EventStats, PREFETCH_FROM,
-};
+use super::{EightWay, EventQueue, EventStats, PREFETCH_FROM};
 use crate::physics::contact::{reflect_walls, resolve_pair};
 use crate::physics::exec::Exec;
 use crate::physics::flight::fly;
 use crate::physics::sphere::Sphere;
-use crate::physics::world::{Counters, World};
+use crate::physics::world::{Counters, Stamp, World};
 
 /// Internal times are kept relative to an origin that moves with the frames,
 /// so lazy positions `x + v (t - t_i)` never subtract large times.
@@ -54,10 +52,8 @@ pub(super) struct EventLoop<L> {
     pub(super) size: f64,
     /// Absolute time of internal time zero.
     pub(super) origin: f64,
-    /// World time the bodies were last written back at.
-    pub(super) synced_time: f64,
-    /// `World::generation` of the world they were last written to.
-    pub(super) synced_generation: u64,
+    /// The stamp of the world the bodies were last written to.
+    pub(super) synced: Stamp,
     pub(super) valid: bool,
     /// Whether the loop prefetches ([`PREFETCH_FROM`]).
     pub(super) prefetching: bool,
@@ -65,7 +61,7 @@ pub(super) struct EventLoop<L> {
 
 impl<L: Locality> EventLoop<L> {
     fn event_cap(&self, hooks: &Hooks) -> u64 {
-        hooks.event_cap(EVENT_CAP_BASE + EVENT_CAP_PER_SPHERE * self.bodies.len() as u64)
+        hooks.event_cap(super::event_cap(self.bodies.len()))
     }
 
     /// A new locality and a prediction for every sphere, at the bodies'
@@ -163,7 +159,7 @@ impl<L: Locality> EventLoop<L> {
                 Kind::Wall => {
                     stats.walls += 1;
                     let mut s = self.bodies.sphere(i);
-                    let mask = [ev.mask() & 1 != 0, ev.mask() & 2 != 0, ev.mask() & 4 != 0];
+                    let mask = ev.mask();
                     onto_walls(&mut s, mask, self.size);
                     let (imp, hits) = reflect_walls(&mut s, mask);
                     let b = &mut self.bodies[i];
@@ -284,9 +280,9 @@ impl<L: Locality> Run for EventLoop<L> {
 
 /// A sphere at a wall event, put on the walls of the axes it hits exactly:
 /// lazy positions never drift out.
-fn onto_walls(s: &mut Sphere, mask: [bool; 3], size: f64) {
-    for (k, &hit) in mask.iter().enumerate() {
-        if hit && s.vel[k] != 0.0 {
+fn onto_walls(s: &mut Sphere, mask: u8, size: f64) {
+    for k in 0..3 {
+        if mask & (1 << k) != 0 && s.vel[k] != 0.0 {
             s.pos[k] = if s.vel[k] < 0.0 {
                 s.radius
             } else {

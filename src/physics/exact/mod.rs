@@ -81,6 +81,12 @@ pub use queue::EventQueue;
 pub const EVENT_CAP_BASE: u64 = 1_000_000;
 pub const EVENT_CAP_PER_SPHERE: u64 = 100;
 
+/// The events a step of `n` spheres may take (its event cap).
+#[must_use]
+pub fn event_cap(n: usize) -> u64 {
+    EVENT_CAP_BASE.saturating_add(EVENT_CAP_PER_SPHERE.saturating_mul(n as u64))
+}
+
 /// Above this packing fraction the locality is neighbour lists (a
 /// sphere's free path is short, so it meets its skin's edge rarely and
 /// checks fewer partners than 27 cells hold); below it, cells with crossing

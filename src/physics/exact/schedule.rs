@@ -273,24 +273,11 @@ impl<'a> Predictor<'a> {
     }
 }
 
-/// Earliest wall contact of `a` (relative time) and the mask of the axes hit
-/// then (a corner hit flips every axis that ties); as
-/// [`wall_toi`](crate::physics::contact::wall_toi), with selects instead of
-/// branches on the signs of the velocity.
+/// Earliest wall contact of `a` (relative time) and the axes hit then:
+/// [`contact::wall_toi`](crate::physics::contact::wall_toi) of its body.
 #[inline]
 pub fn wall_toi(a: &Body, radius: f64, size: f64) -> (f64, u8) {
-    let mut t = [f64::INFINITY; 3];
-    for (k, tk) in t.iter_mut().enumerate() {
-        let v = a.vel[k];
-        // Indexing, not `if`: LLVM turns a select on the (random) sign back
-        // into a branch, and that branch mispredicted half the time.
-        let gap = [size - radius - a.pos[k], a.pos[k] - radius][(v < 0.0) as usize];
-        let dt = (gap / v.abs()).max(0.0);
-        *tk = [f64::INFINITY, dt][(v != 0.0) as usize];
-    }
-    let tmin = t[0].min(t[1]).min(t[2]);
-    let mask = (t[0] == tmin) as u8 | ((t[1] == tmin) as u8) << 1 | ((t[2] == tmin) as u8) << 2;
-    (tmin, mask)
+    crate::physics::contact::wall_toi(a.pos, a.vel, radius, size)
 }
 
 #[cfg(test)]

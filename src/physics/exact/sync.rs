@@ -38,8 +38,7 @@ impl<L: Locality> EventLoop<L> {
             locality: L::default(),
             size: world.size,
             origin: world.time,
-            synced_time: world.time,
-            synced_generation: world.generation(),
+            synced: world.stamp(),
             valid: false,
             prefetching: false,
         };
@@ -48,15 +47,9 @@ impl<L: Locality> EventLoop<L> {
     }
 
     /// Whether `world` is the one we last wrote, untouched since: its
-    /// generation (every edit from outside a model calls `World::touch`),
-    /// time, size and count are those of our write-back. The edit signal
-    /// is the generation alone, as for `swept`: no pass over the spheres.
+    /// stamp is our write-back's (no pass over the spheres).
     pub(super) fn matches(&self, world: &World) -> bool {
-        self.valid
-            && world.generation() == self.synced_generation
-            && world.size == self.size
-            && world.time == self.synced_time
-            && world.spheres.len() == self.bodies.len()
+        self.valid && world.stamp() == self.synced
     }
 
     pub(super) fn write_back(&mut self, world: &mut World) {
@@ -67,7 +60,6 @@ impl<L: Locality> EventLoop<L> {
             s.pos = b.pos;
             s.vel = b.vel;
         }
-        self.synced_time = world.time;
-        self.synced_generation = world.generation();
+        self.synced = world.stamp();
     }
 }

@@ -219,7 +219,8 @@ impl Run {
             self.advance_to(la, e.t);
             self.count[la] += 1;
             if e.b == WALL {
-                let (_, mask) = wall_toi(&self.sp[la], sh.size);
+                let s = &self.sp[la];
+                let (_, mask) = wall_toi(s.pos, s.vel, s.radius, sh.size);
                 let (imp, hits) = reflect_walls(&mut self.sp[la], mask);
                 self.wall_momentum[la] += imp;
                 self.wall_hits[la] += hits as u32;

@@ -99,7 +99,7 @@ pub(super) fn push_wall(
     size: f64,
     dt: f64,
 ) {
-    let (tw, _) = wall_toi(s, size);
+    let (tw, _) = wall_toi(s.pos, s.vel, s.radius, size);
     if t + tw <= dt {
         heap.push(Event {
             t: t + tw,
