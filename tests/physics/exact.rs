@@ -334,43 +334,6 @@ fn prefetching_changes_nothing() {
     }
 }
 
-/// What exact holds a sphere besides its bodies and its queue (issue 20):
-/// the cell grid (4 cells a sphere at most, each one word; a block only for
-/// a cell of two spheres or more; each sphere's packed cell) and a 16-byte
-/// slot (with a byte apart for which event the queue holds). Before, the
-/// grid alone took 16 bytes a cell and 14 a sphere (about 85 a sphere),
-/// the event and pending records 36.
-#[test]
-fn the_cell_grid_and_the_event_slots_stay_small() {
-    use ballpit::physics::exact::body::Bodies;
-    use ballpit::physics::exact::cell_grid::{CELLS_PER_SPHERE, CellGrid};
-    use ballpit::physics::exact::schedule::Slot;
-    use ballpit::scene::{SceneSpec, build_world};
-    assert_eq!(size_of::<Slot>(), 16);
-    for radius in [0.002_285_39, 0.006_19] {
-        // 100k spheres at packing 0.005 and 0.1.
-        let w = build_world(&SceneSpec {
-            count: Some(100_000),
-            radius: Some(radius),
-            seed: Some(5),
-            ..Default::default()
-        })
-        .unwrap();
-        let bodies = Bodies::from_spheres(w.spheres.iter(), 0.0);
-        let mut grid = CellGrid::default();
-        grid.build(&bodies, w.size, CELLS_PER_SPHERE);
-        let cells = grid.cells() as f64 / bodies.len() as f64;
-        let per = grid.heap_bytes() as f64 / bodies.len() as f64;
-        // The cells the spheres make: at least 3 a sphere (the cap is 4),
-        // so a word a cell would be out of reach if cells were blocks.
-        assert!(cells > 3.0 && cells < 4.5, "{cells} cells a sphere");
-        assert!(
-            per < 4.0 * cells + 8.0,
-            "{per} bytes a sphere, {cells} cells"
-        );
-    }
-}
-
 /// The model's whole heap at 100k spheres (issue 20): a body of one line
 /// holding its count and species (no arrays of counts or masses), the slot,
 /// the tournament, the cells, the labels. 137 bytes a sphere when this was

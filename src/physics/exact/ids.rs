@@ -59,7 +59,7 @@ index_type!(
 
 index_type!(
     /// A radius–mass pair's place in the model's species table.
-    SpeciesId, packed
+    SpeciesId
 );
 
 index_type!(

@@ -50,8 +50,8 @@
 //! (contacts in its remainder are missed, so overlaps may then appear), and
 //! the schedule is rebuilt for the next step.
 mod ahead;
-pub mod body;
-pub mod cell_grid;
+mod body;
+mod cell_grid;
 mod eight_way;
 mod event_loop;
 mod hooks;
@@ -61,7 +61,7 @@ mod locality;
 mod neighbour_lists;
 mod overlap;
 mod queue;
-pub mod schedule;
+mod schedule;
 mod spatial;
 mod species;
 mod sync;

@@ -114,7 +114,7 @@ impl Queued {
 
     /// The queue holds `ev`, a crossing or a large sphere's rescan ([`Kind::Relist`]).
     #[inline(always)]
-    pub fn locality(ev: &Event) -> Queued {
+    pub fn locality(ev: Event) -> Queued {
         Queued(Self::LOCALITY | ev.mask() | u8::from(ev.kind() == Kind::Relist) << Self::RESCAN_BIT)
     }
 
@@ -313,7 +313,7 @@ mod tests {
     fn a_queued_locality_event_reads_back() {
         assert!(!Queued::PENDING.is_locality());
         for (kind, mask) in [(Kind::Cross, 0), (Kind::Cross, 6), (Kind::Relist, 0)] {
-            let q = Queued::locality(&Event::of(kind, mask));
+            let q = Queued::locality(Event::of(kind, mask));
             assert!(q.is_locality());
             assert_eq!((q.event().kind(), q.event().mask()), (kind, mask));
         }

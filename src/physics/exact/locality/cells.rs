@@ -170,6 +170,6 @@ fn with_crossing(
     // By index: which comes first is random, and a branch on it
     // mispredicted a third of the time.
     let first = usize::from(tc <= tp);
-    *holds = [Queued::PENDING, Queued::locality(&ev)][first];
+    *holds = [Queued::PENDING, Queued::locality(ev)][first];
     [tp, tc][first]
 }
