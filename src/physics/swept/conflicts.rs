@@ -32,7 +32,7 @@ pub(super) struct Finished {
     /// The round that run was made in ([`NOT_RUN`] before any).
     ran: Vec<AtomicU32>,
     /// Whether (and why) that run was capped, and whether the member's ball
-    /// grew past the one the grid holds for it ([`Marks`]).
+    /// grew past the one the grid holds for it ([`marks`]).
     marks: Vec<AtomicU8>,
     /// The runs' outputs, each taken whole from the block that wrote it
     /// (not copied: a record and its turns are kept once). Not pooled for
@@ -46,27 +46,25 @@ const NO_RECORD: u64 = u64::MAX;
 /// `Finished::ran` of a slot whose cluster has not run.
 const NOT_RUN: u32 = u32::MAX;
 
+/// In a slot's marks byte: its ball grew (the low two bits are the cap).
+const GREW: u8 = 1 << 2;
+
 /// A slot's cap and growth, packed in a byte.
-struct Marks;
+fn marks(capped: Option<Coarse>, grew: bool) -> u8 {
+    let c = match capped {
+        None => 0,
+        Some(Coarse::Events) => 1,
+        Some(Coarse::Work) => 2,
+    };
+    c | if grew { GREW } else { 0 }
+}
 
-impl Marks {
-    const GREW: u8 = 1 << 2;
-
-    fn pack(capped: Option<Coarse>, grew: bool) -> u8 {
-        let c = match capped {
-            None => 0,
-            Some(Coarse::Events) => 1,
-            Some(Coarse::Work) => 2,
-        };
-        c | if grew { Marks::GREW } else { 0 }
-    }
-
-    fn capped(m: u8) -> Option<Coarse> {
-        match m & 3 {
-            0 => None,
-            1 => Some(Coarse::Events),
-            _ => Some(Coarse::Work),
-        }
+/// The cap a marks byte holds.
+fn capped_of(marks: u8) -> Option<Coarse> {
+    match marks & 3 {
+        0 => None,
+        1 => Some(Coarse::Events),
+        _ => Some(Coarse::Work),
     }
 }
 
@@ -87,7 +85,7 @@ impl Finished {
         self.at.iter_mut().for_each(|a| *a.get_mut() = NO_RECORD);
         // The caps stay (the one run sets them all again); growth goes.
         for m in &mut self.marks {
-            *m.get_mut() &= !Marks::GREW;
+            *m.get_mut() &= !GREW;
         }
         self.chunks.clear();
     }
@@ -111,14 +109,14 @@ impl Finished {
         (self.chunks.len() - 1) as u32
     }
 
-    /// Slot `s` finished in round `round` as member `k` (record `m`) of
-    /// chunk `c`, its run capped as `capped`. A chunk not yet kept is named
-    /// by the number it will have.
-    pub fn set(&self, s: usize, c: u32, k: usize, m: &Member, capped: Option<Coarse>, round: u32) {
+    /// Slot `s` finished in round `round` as member `k` of chunk `c` (its
+    /// ball `grew` or not), its run capped as `capped`. A chunk not yet
+    /// kept is named by the number it will have.
+    pub fn set(&self, s: usize, c: u32, k: usize, grew: bool, capped: Option<Coarse>, round: u32) {
         let at = (u64::from(c) << 32) | k as u64;
         self.at[s].store(at, Ordering::Relaxed);
         self.ran[s].store(round, Ordering::Relaxed);
-        self.marks[s].store(Marks::pack(capped, m.grew), Ordering::Relaxed);
+        self.marks[s].store(marks(capped, grew), Ordering::Relaxed);
     }
 
     /// The round slot `s`'s cluster last ran in ([`NOT_RUN`] before any).
@@ -128,7 +126,7 @@ impl Finished {
 
     /// Whether (and why) slot `s`'s last run was capped.
     pub fn capped(&self, s: usize) -> Option<Coarse> {
-        Marks::capped(self.marks[s].load(Ordering::Relaxed))
+        capped_of(self.marks[s].load(Ordering::Relaxed))
     }
 
     /// Slot `s`'s record and its turns, if its cluster ran.
@@ -146,7 +144,7 @@ impl Finished {
 
     /// Whether slot `s`'s ball grew past the one the grid holds for it.
     pub fn grew(&self, s: usize) -> bool {
-        self.marks[s].load(Ordering::Relaxed) & Marks::GREW != 0
+        self.marks[s].load(Ordering::Relaxed) & GREW != 0
     }
 
     /// Whether the spheres of slots `a` and `b` come within touching

@@ -1,7 +1,7 @@
 //! The spheres with events take their runs' ends of the step, and the
 //! counters their totals, in sphere order, so the sums are the serial
-//! loop's to the bit. On many lanes (`wide.rs`) the results are cut into
-//! blocks, each a run of sphere ids, that write their spheres and count
+//! loop's to the bit. The results are cut into blocks (one below
+//! `wide.rs`'s lanes), each a run of sphere ids, that write their spheres and count
 //! in parallel; the integer counts add exactly in any order, and the one
 //! sum that rounds, the momentum given to the walls, is then taken over
 //! the few spheres that hit one, in sphere order.
@@ -38,19 +38,13 @@ pub(super) fn take_results(
     totals: &mut PerBlock<Totals>,
 ) -> Option<Coarse> {
     let m = rounds.involved();
-    if !wide_pass(exec, m, RESULT_BLOCK) {
-        let mut capped = None;
-        for (r, cap) in rounds.results() {
-            let s = &mut spheres[r.id as usize];
-            (s.pos, s.vel) = (r.pos, r.vel);
-            c.wall_momentum += r.wall_momentum;
-            c.sphere_collisions += u64::from(r.pair_hits);
-            c.wall_collisions += u64::from(r.wall_hits);
-            capped = capped.max(cap);
-        }
-        return capped;
-    }
-    let blocks = m.div_ceil(RESULT_BLOCK);
+    // One block on few lanes: the same loop, on the calling thread.
+    let per = if wide_pass(exec, m, RESULT_BLOCK) {
+        RESULT_BLOCK
+    } else {
+        m.max(1)
+    };
+    let blocks = m.div_ceil(per);
     // The results are in sphere order: block `b`'s spheres are the ids from
     // its first result's up to the next block's first.
     let mut pieces = Vec::with_capacity(blocks);
@@ -59,7 +53,7 @@ pub(super) fn take_results(
         let end = if b + 1 == blocks {
             base + rest.len()
         } else {
-            rounds.result((b + 1) * RESULT_BLOCK).0.id as usize
+            rounds.result((b + 1) * per).0.id as usize
         };
         let (mine, after) = rest.split_at_mut(end - base);
         pieces.push(Mutex::new((base, mine)));
@@ -71,12 +65,9 @@ pub(super) fn take_results(
         let mut piece = pieces[b].lock();
         let (first, mine) = &mut *piece;
         let mut t = sums[b].lock();
-        *t = Totals {
-            momenta: std::mem::take(&mut t.momenta),
-            ..Totals::default()
-        };
+        (t.pair_hits, t.wall_hits, t.capped) = (0, 0, None);
         t.momenta.clear();
-        for k in b * RESULT_BLOCK..((b + 1) * RESULT_BLOCK).min(m) {
+        for k in b * per..((b + 1) * per).min(m) {
             let (r, cap) = rounds.result(k);
             let s = &mut mine[r.id as usize - *first];
             (s.pos, s.vel) = (r.pos, r.vel);

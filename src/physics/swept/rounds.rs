@@ -89,7 +89,7 @@ pub(super) struct Rounds {
     /// One run's scratch per lane, one output per block of clusters.
     runs: PerBlock<Run>,
     outs: PerBlock<BlockOut>,
-    /// The slots in sphere order, for [`Rounds::results`], and scratch for
+    /// The slots in sphere order, for [`Rounds::result`], and scratch for
     /// the late ones.
     in_order: Vec<Slot>,
     late: Vec<Slot>,
@@ -103,20 +103,15 @@ pub(super) struct Rounds {
 }
 
 impl Rounds {
-    /// The results of the last `run`: every sphere that had events, with
-    /// its run's end of the step and whether (and why) the run was capped,
-    /// in sphere order (so totals summed in this order are the serial
-    /// loop's to the bit, however the clusters fell).
-    pub fn results(&self) -> impl Iterator<Item = (&Member, Option<Coarse>)> {
-        (0..self.involved()).map(|k| self.result(k))
-    }
-
     /// How many spheres had events in the last `run`.
     pub fn involved(&self) -> usize {
         self.in_order.len()
     }
 
-    /// The `k`-th of [`Rounds::results`].
+    /// The `k`-th result of the last `run`: of every sphere that had
+    /// events, in sphere order (so totals summed in this order are the
+    /// serial loop's to the bit, however the clusters fell), its run's end
+    /// of the step and whether (and why) the run was capped.
     pub fn result(&self, k: usize) -> (&Member, Option<Coarse>) {
         let s = self.in_order[k].index();
         let Some((m, _)) = self.fin.record(s) else {
@@ -128,7 +123,7 @@ impl Rounds {
     /// Runs the events of a step: `meets` are the pairs whose straight paths
     /// meet within `dt`, `near` pairs whose balls overlap but do not meet,
     /// `hits` the spheres that reach a wall. Each involved sphere's end of
-    /// the step is then among [`Rounds::results`]; `spheres` is not changed.
+    /// the step is then among the results ([`Rounds::result`]); `spheres` is not changed.
     /// The runs may do `budget` work in all, each round's split over its
     /// runs by their members (so not by lanes); [`Rounds::work`] says how
     /// much they did.
@@ -382,10 +377,9 @@ impl Rounds {
         let mut twice = false;
         let first = self.fin.record_in(c, k0).map(|(m, _)| m.id);
         for &k in joined {
-            let Some((m, _)) = self.fin.record_in(c, k as usize) else {
+            let Some((&Member { id, grew, .. }, _)) = self.fin.record_in(c, k as usize) else {
                 unreachable!("a chunk holds the members its runs wrote");
             };
-            let id = m.id;
             // It may have got a slot from an earlier run of this round.
             let s = match self.part.slot[id as usize] {
                 Slot::NONE => self.add_slot(id),
@@ -393,10 +387,8 @@ impl Rounds {
             };
             debug_assert!(s.index() >= known, "a bystander's slot is this round's");
             twice |= self.fin.ran(s.index()) == round;
-            let Some((m, _)) = self.fin.record_in(c, k as usize) else {
-                unreachable!("a chunk holds the members its runs wrote");
-            };
-            self.fin.set(s.index(), c, k as usize, m, r.capped, round);
+            self.fin
+                .set(s.index(), c, k as usize, grew, r.capped, round);
             root = if root.is_none() {
                 self.part.find(s)
             } else {
@@ -446,7 +438,7 @@ fn set_own(
             out.joined.push(k as u32);
         } else {
             own = s;
-            fin.set(s.index(), c, k, m, capped, round);
+            fin.set(s.index(), c, k, m.grew, capped, round);
         }
     }
     own
