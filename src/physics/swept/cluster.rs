@@ -270,6 +270,12 @@ impl Run {
         self.turn_log.push((l as u32, Turn { t, vel: s.vel }));
     }
 
+    /// Each member's slot at the run's start, in the order `emit` writes
+    /// them (`Slot::NONE` for the bystanders that joined).
+    pub fn slots(&self) -> &[Slot] {
+        &self.slots
+    }
+
     /// Writes the members of the last finished run, each with its turns
     /// together in time order, to `out`.
     pub fn emit(&mut self, out: &mut Chunk) {

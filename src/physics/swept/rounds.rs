@@ -310,7 +310,14 @@ impl Rounds {
                 let before = out.chunk.members.len();
                 run.emit(&mut out.chunk);
                 out.cross.extend_from_slice(&run.cross);
-                let own = set_own(fin, sh, out, before, first + b as u32, (run.capped, round));
+                let own = set_own(
+                    fin,
+                    run.slots(),
+                    out,
+                    before,
+                    first + b as u32,
+                    (run.capped, round),
+                );
                 out.done.push(RunDone {
                     capped: run.capped,
                     len: (out.chunk.members.len() - before) as u32,
@@ -425,15 +432,15 @@ impl Rounds {
 /// the run's. Returns a slot of its own (none if it had only bystanders).
 fn set_own(
     fin: &Finished,
-    sh: &Shared,
+    slots: &[Slot],
     out: &mut BlockOut,
     from: usize,
     c: u32,
     (capped, round): (Option<Coarse>, u32),
 ) -> Slot {
     let mut own = Slot::NONE;
-    for (k, m) in out.chunk.members.iter().enumerate().skip(from) {
-        let s = sh.slot[m.id as usize];
+    let members = out.chunk.members.iter().enumerate().skip(from);
+    for ((k, m), &s) in members.zip(slots) {
         if s.is_none() {
             out.joined.push(k as u32);
         } else {
